@@ -1,0 +1,86 @@
+// nphand: one binary, one subcommand per pipeline job. Each subcommand binds its flags to
+// the fields of an options struct and calls the matching Run* function.
+#include <cstdio>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "apps/bench_command.h"
+#include "apps/render_command.h"
+#include "nphand/util/check.h"
+
+namespace {
+
+void AddRenderCommand(CLI::App& app, nphand::RenderCommandOptions& o) {
+  CLI::App* cmd = app.add_subcommand("render", "Render a posed hand (and an object) to PNG: RGB, labels, depth, keypoints");
+  cmd->add_option("--hand", o.hand, "Which hand: right or left")->capture_default_str();
+  cmd->add_option("--pose", o.pose, "Named articulation: rest, relaxed, fist, point, pinch")->capture_default_str();
+  cmd->add_option("--angle", o.angles, "Override a joint angle, NAME=DEGREES (e.g. index_pip_flex=45); repeatable");
+  cmd->add_option("--azimuth", o.azimuth_deg, "Viewpoint azimuth, degrees (0: palm, 180: back)")->capture_default_str();
+  cmd->add_option("--elevation", o.elevation_deg, "Viewpoint elevation, degrees")->capture_default_str();
+  cmd->add_option("--roll", o.roll_deg, "Camera roll about the optical axis, degrees")->capture_default_str();
+  cmd->add_option("--distance", o.distance, "Camera to hand centre, metres")->capture_default_str();
+  cmd->add_option("--width", o.width, "Image width, pixels")->capture_default_str();
+  cmd->add_option("--height", o.height, "Image height, pixels")->capture_default_str();
+  cmd->add_option("--fov", o.fov_deg, "Horizontal field of view, degrees")->capture_default_str();
+  cmd->add_option("--object", o.object, "Object shape: sphere, cylinder, box, disk, torus, stick");
+  cmd->add_option("--object-size", o.object_size,
+                  "Object size in metres: sphere r; cylinder r,length; box x,y,z; disk r,thickness; "
+                  "torus R,r; stick r,length")->delimiter(',');
+  cmd->add_option("--object-at", o.object_at, "Object centre in the hand frame x,y,z, metres")
+      ->delimiter(',')->capture_default_str();
+  cmd->add_option("--object-rotate", o.object_rotate_deg, "Object rotation about hand x,y,z, degrees")
+      ->delimiter(',')->capture_default_str();
+  cmd->add_option("--background", o.background, "Image file to draw behind the scene");
+  cmd->add_option("--out", o.out_dir, "Output folder")->capture_default_str();
+  cmd->add_option("--name", o.name, "File name prefix")->capture_default_str();
+  cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+  cmd->callback([&o]() {
+    const nphand::RenderCommandResult result = nphand::RunRender(o);
+    for (const auto& path : result.files) std::cout << path.string() << "\n";
+    std::cout << "hand pixels: " << result.hand_pixels << ", object pixels: " << result.object_pixels << "\n";
+  });
+}
+
+void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, bool& json) {
+  CLI::App* bench = app.add_subcommand("bench", "Measure the speed of a pipeline stage");
+  bench->require_subcommand(1);
+  CLI::App* render = bench->add_subcommand("render", "Label images per second (hand + object, one core)");
+  render->add_option("--images", o.images, "Images to time")->capture_default_str();
+  render->add_option("--size", o.size, "Square image side, pixels")->capture_default_str();
+  render->add_option("--seed", o.seed, "Seed of the viewpoints and articulations")->capture_default_str();
+  render->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+  render->add_flag("--json", json, "Print one JSON object");
+  render->callback([&o, &json]() {
+    const nlohmann::json report = nphand::RunBenchRender(o);
+    if (json) {
+      std::cout << report.dump() << "\n";
+    } else {
+      std::cout << report.dump(2) << "\n";
+    }
+  });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"nphand: non-parametric hand pose estimation with object context"};
+  app.require_subcommand(1);
+  nphand::RenderCommandOptions render_options;
+  nphand::BenchRenderOptions bench_options;
+  bool json = false;
+  AddRenderCommand(app, render_options);
+  AddBenchCommand(app, bench_options, json);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const nphand::Error& e) {
+    std::fprintf(stderr, "nphand: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "nphand: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

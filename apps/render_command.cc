@@ -1,0 +1,123 @@
+#include "apps/render_command.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "nphand/render/draw.h"
+#include "nphand/render/renderer.h"
+#include "nphand/scene/viewpoint.h"
+#include "nphand/util/check.h"
+
+namespace nphand {
+namespace {
+
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+
+JointAngles ArticulationOf(const RenderCommandOptions& options) {
+  JointAngles angles = NamedArticulation(options.pose);
+  for (const std::string& assignment : options.angles) {
+    const size_t eq = assignment.find('=');
+    NPHAND_THROW_CHECK(eq != std::string::npos, "--angle '", assignment, "': expected NAME=DEGREES");
+    const int dof = DofFromString(assignment.substr(0, eq));
+    double degrees = 0.0;
+    try {
+      size_t used = 0;
+      degrees = std::stod(assignment.substr(eq + 1), &used);
+      NPHAND_THROW_CHECK(used == assignment.size() - eq - 1, "--angle '", assignment, "': not a number");
+    } catch (const std::logic_error&) {
+      NPHAND_THROW("--angle '", assignment, "': not a number");
+    }
+    angles[dof] = degrees * kRadPerDeg;
+  }
+  const JointAngles clamped = ClampToLimits(angles);
+  for (int i = 0; i < kNumDofs; ++i) {
+    NPHAND_THROW_CHECK(clamped[i] == angles[i], "--angle ", Dofs()[i].name, "=", angles[i] / kRadPerDeg,
+                       " is outside its limits [", Dofs()[i].min_rad / kRadPerDeg, ", ",
+                       Dofs()[i].max_rad / kRadPerDeg, "] degrees");
+  }
+  return angles;
+}
+
+}  // namespace
+
+bool RenderCommandOptions::Check(std::string* why) const {
+  if (!(distance > 0.05 && distance < 100.0)) {
+    *why = "--distance must be between 0.05 and 100 metres";
+    return false;
+  }
+  if (!(fov_deg > 1.0 && fov_deg < 170.0)) {
+    *why = "--fov must be between 1 and 170 degrees";
+    return false;
+  }
+  if (object_at.size() != 3 || object_rotate_deg.size() != 3) {
+    *why = "--object-at and --object-rotate take three values";
+    return false;
+  }
+  if (!object.empty() && static_cast<int>(object_size.size()) != ObjectSizeCount(ObjectShapeFromString(object))) {
+    *why = "--object-size for a " + object + " takes " + ObjectSizeMeaning(ObjectShapeFromString(object));
+    return false;
+  }
+  return Intrinsics::FromFieldOfView(width, height, fov_deg * kRadPerDeg).Check(why);
+}
+
+RenderCommandResult RunRender(const RenderCommandOptions& options) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "render: ", why);
+  const Handedness handedness = HandednessFromString(options.hand);
+  const HandModel model = HandModel::Load(handedness, options.asset_dir);
+
+  Scene scene;
+  scene.hand.handedness = handedness;
+  scene.hand.angles = ArticulationOf(options);
+  scene.hand.camera_from_hand = CameraFromHand(
+      {options.azimuth_deg * kRadPerDeg, options.elevation_deg * kRadPerDeg, options.roll_deg * kRadPerDeg});
+  scene.wrist_in_camera =
+      CenteredWristPosition(scene.hand.camera_from_hand, model.bind_centre(), options.distance);
+  if (!options.object.empty()) {
+    SceneObject object;
+    object.spec.shape = ObjectShapeFromString(options.object);
+    std::copy(options.object_size.begin(), options.object_size.end(), object.spec.size.begin());
+    NPHAND_THROW_CHECK(object.spec.Check(&why), "render: ", why);
+    object.hand_from_object.translation() = Eigen::Vector3d(options.object_at[0], options.object_at[1], options.object_at[2]);
+    object.hand_from_object.linear() = (AxisAngle(Eigen::Vector3d::UnitZ(), options.object_rotate_deg[2] * kRadPerDeg) *
+                                        AxisAngle(Eigen::Vector3d::UnitY(), options.object_rotate_deg[1] * kRadPerDeg) *
+                                        AxisAngle(Eigen::Vector3d::UnitX(), options.object_rotate_deg[0] * kRadPerDeg));
+    scene.objects.push_back(object);
+  }
+
+  RenderOptions render_options;
+  if (!options.background.empty()) {
+    render_options.background = cv::imread(options.background, cv::IMREAD_COLOR);
+    NPHAND_THROW_CHECK(!render_options.background.empty(), options.background, ": cannot read the background image");
+  }
+  const Intrinsics intrinsics = Intrinsics::FromFieldOfView(options.width, options.height, options.fov_deg * kRadPerDeg);
+  Renderer renderer(model);
+  const RenderedImages images = renderer.Render(scene, intrinsics, render_options);
+
+  Keypoints3d keypoints = model.KeypointsOf(scene.hand);
+  for (Eigen::Vector3d& k : keypoints) k += scene.wrist_in_camera;
+  cv::Mat overlay = images.rgb.clone();
+  DrawKeypoints(intrinsics, keypoints, &overlay);
+  cv::Mat depth_mm;
+  images.depth.convertTo(depth_mm, CV_16UC1, 1000.0);
+
+  std::filesystem::create_directories(options.out_dir);
+  RenderCommandResult result;
+  const auto write = [&](const std::string& suffix, const cv::Mat& image) {
+    const std::filesystem::path path = options.out_dir / (options.name + "_" + suffix + ".png");
+    WriteImageAtomic(path, image);
+    result.files.push_back(path);
+  };
+  write("rgb", images.rgb);
+  write("labels", LabelsForDisplay(images.labels));
+  write("depth", depth_mm);
+  write("keypoints", overlay);
+  result.hand_pixels = cv::countNonZero(images.labels == static_cast<int>(PixelLabel::kHand));
+  result.object_pixels = cv::countNonZero(images.labels == static_cast<int>(PixelLabel::kObject));
+  return result;
+}
+
+}  // namespace nphand

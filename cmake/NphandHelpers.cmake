@@ -1,0 +1,27 @@
+# Compiler flags shared by every nphand target.
+add_library(nphand_flags INTERFACE)
+target_compile_options(nphand_flags INTERFACE -Wall -Wextra)
+if(NPHAND_WERROR)
+  target_compile_options(nphand_flags INTERFACE -Werror)
+endif()
+if(NPHAND_SANITIZE)
+  target_compile_options(nphand_flags INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer
+                         -fno-sanitize-recover=undefined)
+  target_link_options(nphand_flags INTERFACE -fsanitize=address,undefined)
+endif()
+
+# nphand_stage(NAME SOURCES ... DEPS ...): one pipeline stage as its own library target.
+function(nphand_stage name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(nphand_${name} STATIC ${ARG_SOURCES})
+  target_include_directories(nphand_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(nphand_${name} PUBLIC nphand_flags ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+endfunction()
+
+# nphand_test(STAGE UNIT): tests/STAGE/UNIT_test.cc registered in CTest as STAGE/UNIT_test.
+function(nphand_test stage unit)
+  set(target test_${stage}_${unit})
+  add_executable(${target} ${unit}_test.cc)
+  target_link_libraries(${target} PRIVATE nphand_testing ${ARGN})
+  add_test(NAME ${stage}/${unit}_test COMMAND ${target})
+endfunction()

@@ -1,0 +1,85 @@
+// The rigged hand: the generic-hand mesh, its skeleton, forward kinematics, linear-blend
+// skinning and the 21 keypoints.
+//
+// Frames: the mesh is moved at load into the hand frame (origin at the wrist joint, x
+// towards the middle finger's MCP, z out of the back of the hand). Posed outputs are in
+// the camera orientation with the wrist at the origin: p = camera_from_hand * p_hand.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "nphand/model/hand_pose.h"
+#include "nphand/model/skeleton.h"
+
+namespace nphand {
+
+// The folder holding right.glb and left.glb: $NPHAND_ASSET_DIR if set, else the cache that
+// scripts/setup.sh fills.
+std::filesystem::path DefaultAssetDir();
+// The pinned sha256 of the asset file of a hand (right.glb / left.glb of
+// @webxr-input-profiles/assets@1.0.20).
+const char* PinnedAssetSha256(Handedness handedness);
+// "right.glb" or "left.glb".
+std::string AssetFileName(Handedness handedness);
+
+using Keypoints3d = std::array<Eigen::Vector3d, kNumKeypoints>;
+using JointPositions = std::array<Eigen::Vector3d, kNumJoints>;
+
+class HandModel {
+ public:
+  // Loads <asset_dir>/<right|left>.glb. Throws nphand::Error if it is missing, its sha256
+  // differs from the pinned one, or it is not the expected rigged hand.
+  static HandModel Load(Handedness handedness, const std::filesystem::path& asset_dir = DefaultAssetDir());
+  // Parses a binary glTF already in memory (no hash check); `source` names it in errors.
+  static HandModel FromGlb(std::span<const uint8_t> glb, Handedness handedness, const std::string& source);
+
+  Handedness handedness() const { return handedness_; }
+  // The mesh in its bind pose, in the hand frame (metres).
+  const std::vector<Eigen::Vector3f>& bind_vertices() const { return bind_vertices_; }
+  const std::vector<Eigen::Vector3f>& bind_normals() const { return bind_normals_; }
+  const std::vector<Eigen::Vector3i>& triangles() const { return triangles_; }
+  // Joint positions of the bind pose in the hand frame.
+  const JointPositions& bind_joint_positions() const { return bind_positions_; }
+  // The mean of the bind-pose joint positions: a point near the middle of the hand, for
+  // centring it in a view.
+  Eigen::Vector3d bind_centre() const;
+  // The anatomical frame of each joint in the bind pose (columns: bone, flexion axis,
+  // dorsal normal), in the hand frame.
+  const Eigen::Matrix3d& bind_joint_axes(int joint) const { return bind_axes_[joint]; }
+
+  // Forward kinematics: each joint's posed frame in the hand frame (before camera_from_hand).
+  std::array<Eigen::Isometry3d, kNumJoints> JointTransforms(const JointAngles& angles) const;
+  // Posed joint positions and keypoints in the camera orientation, wrist at the origin.
+  JointPositions JointPositionsOf(const HandPose& pose) const;
+  Keypoints3d KeypointsOf(const HandPose& pose) const;
+  // Linear-blend skinning: posed vertices (and normals, if not null) in the camera
+  // orientation, wrist at the origin. Outputs are resized to the vertex count.
+  void Skin(const HandPose& pose, std::vector<Eigen::Vector3f>* vertices,
+            std::vector<Eigen::Vector3f>* normals) const;
+
+ private:
+  HandModel() = default;
+  void CheckHandedness(const HandPose& pose) const;
+
+  Handedness handedness_ = Handedness::kRight;
+  std::vector<Eigen::Vector3f> bind_vertices_;
+  std::vector<Eigen::Vector3f> bind_normals_;
+  std::vector<Eigen::Vector3i> triangles_;
+  std::vector<std::array<uint8_t, 4>> skin_joints_;
+  std::vector<Eigen::Vector4f> skin_weights_;
+  JointPositions bind_positions_;
+  std::array<Eigen::Matrix3d, kNumJoints> bind_axes_;
+  // Bind pose: each joint's frame relative to its parent's, and the inverse of its own.
+  std::array<Eigen::Isometry3d, kNumJoints> parent_from_joint_;
+  std::array<Eigen::Isometry3d, kNumJoints> joint_from_hand_;
+};
+
+}  // namespace nphand

@@ -1,0 +1,26 @@
+// Drawing overlays for people to look at: the 21 keypoints and their skeleton.
+#pragma once
+
+#include <filesystem>
+
+#include <opencv2/core.hpp>
+
+#include "nphand/model/hand_model.h"
+#include "nphand/render/camera.h"
+
+namespace nphand {
+
+// Draws the keypoints (camera frame, metres) and the bones between them on a BGR image.
+void DrawKeypoints(const Intrinsics& intrinsics, const Keypoints3d& keypoints_in_camera, cv::Mat* bgr);
+
+// A label image (PixelLabel values) as a grey picture: background black, hand white, object grey.
+cv::Mat LabelsForDisplay(const cv::Mat& labels);
+
+}  // namespace nphand
+
+namespace nphand {
+
+// Encodes `image` by the extension of `path` (.png, .jpg, …) and writes it atomically.
+void WriteImageAtomic(const std::filesystem::path& path, const cv::Mat& image);
+
+}  // namespace nphand

@@ -1,0 +1,23 @@
+// File input and output: whole-file reads, atomic writes, content hashes.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace nphand {
+
+// Reads a whole file. Throws nphand::Error naming the path when it cannot.
+std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path);
+
+// Writes `bytes` to `path` atomically: a temporary file beside it, flushed, then renamed
+// over `path`. A crash leaves either the old file or the new one, never half of one.
+void WriteFileAtomic(const std::filesystem::path& path, std::span<const uint8_t> bytes);
+void WriteFileAtomic(const std::filesystem::path& path, const std::string& text);
+
+// Lower-case hex SHA-256 of `bytes`.
+std::string Sha256Hex(std::span<const uint8_t> bytes);
+
+}  // namespace nphand

@@ -1,0 +1,192 @@
+#include "nphand/model/hand_model.h"
+
+#include <map>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "nphand/util/check.h"
+#include "nphand/util/io.h"
+#include "testing/testing.h"
+
+namespace nphand {
+namespace {
+
+using testing::LeftHand;
+using testing::RightHand;
+
+HandPose RandomPose(Random& random, Handedness handedness) {
+  HandPose pose;
+  pose.handedness = handedness;
+  pose.camera_from_hand =
+      Eigen::Quaterniond(random.Normal(), random.Normal(), random.Normal(), random.Normal()).normalized().toRotationMatrix();
+  pose.angles = RandomArticulation(random);
+  return pose;
+}
+
+TEST(HandModelTest, LoadsTheGenericHandMesh) {
+  for (const HandModel* model : {&RightHand(), &LeftHand()}) {
+    EXPECT_EQ(model->bind_vertices().size(), 1360u);
+    EXPECT_EQ(model->triangles().size(), 2314u);
+    EXPECT_LT(model->bind_joint_positions()[0].norm(), 1e-12) << "the wrist is the origin";
+    const double length = (model->bind_joint_positions()[Index(Joint::kMiddleTip)]).norm();
+    EXPECT_GT(length, 0.15);
+    EXPECT_LT(length, 0.25);
+  }
+}
+
+TEST(HandModelTest, MeshIsClosedAndWoundOutward) {
+  // Vertices split at texture seams share positions: compare edges by position.
+  const HandModel& model = RightHand();
+  auto key = [&](int v) {
+    const Eigen::Vector3f& p = model.bind_vertices()[v];
+    return std::array<long, 3>{std::lround(p.x() * 1e6), std::lround(p.y() * 1e6), std::lround(p.z() * 1e6)};
+  };
+  std::map<std::pair<std::array<long, 3>, std::array<long, 3>>, int> directed;
+  for (const Eigen::Vector3i& t : model.triangles()) {
+    for (int k = 0; k < 3; ++k) ++directed[{key(t[k]), key(t[(k + 1) % 3])}];
+    const auto& v = model.bind_vertices();
+    const Eigen::Vector3f n = (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]);
+    EXPECT_GT(n.dot(model.bind_normals()[t[0]] + model.bind_normals()[t[1]] + model.bind_normals()[t[2]]), 0.0f);
+  }
+  for (const auto& [edge, count] : directed) {
+    ASSERT_EQ(count, 1);
+    ASSERT_TRUE(directed.count({edge.second, edge.first})) << "open edge";
+  }
+}
+
+TEST(HandModelTest, RestPoseReproducesTheBindPose) {
+  for (const HandModel* model : {&RightHand(), &LeftHand()}) {
+    HandPose rest;
+    rest.handedness = model->handedness();
+    std::vector<Eigen::Vector3f> vertices, normals;
+    model->Skin(rest, &vertices, &normals);
+    for (size_t v = 0; v < vertices.size(); ++v) {
+      ASSERT_LT((vertices[v] - model->bind_vertices()[v]).norm(), 1e-6f) << "vertex " << v;
+      ASSERT_LT((normals[v] - model->bind_normals()[v]).norm(), 1e-5f) << "normal " << v;
+    }
+    const JointPositions joints = model->JointPositionsOf(rest);
+    for (int j = 0; j < kNumJoints; ++j) EXPECT_LT((joints[j] - model->bind_joint_positions()[j]).norm(), 1e-12);
+  }
+}
+
+TEST(HandModelTest, BoneLengthsSurviveAnyPose) {
+  Random random(testing::kTestSeed);
+  const JointPositions& bind = RightHand().bind_joint_positions();
+  for (int trial = 0; trial < 100; ++trial) {
+    const JointPositions posed = RightHand().JointPositionsOf(RandomPose(random, Handedness::kRight));
+    for (int j = 1; j < kNumJoints; ++j) {
+      const int p = JointParent(j);
+      ASSERT_NEAR((posed[j] - posed[p]).norm(), (bind[j] - bind[p]).norm(), 1e-12) << JointName(static_cast<Joint>(j));
+    }
+  }
+}
+
+TEST(HandModelTest, KeypointsMoveWithTheirJointsOnly) {
+  Random random(testing::kTestSeed);
+  HandPose pose;
+  pose.angles = NamedArticulation("relaxed");
+  const Keypoints3d before = RightHand().KeypointsOf(pose);
+  for (int i = 0; i < kNumDofs; ++i) {
+    HandPose moved = pose;
+    const DofInfo& dof = Dofs()[i];
+    moved.angles[i] = moved.angles[i] + 0.2 <= dof.max_rad ? moved.angles[i] + 0.2 : moved.angles[i] - 0.2;
+    const Keypoints3d after = RightHand().KeypointsOf(moved);
+    bool some_moved = false;
+    for (int k = 0; k < kNumKeypoints; ++k) {
+      const bool below = IsInSubtree(Index(KeypointJoint(k)), Index(dof.joint)) && KeypointJoint(k) != dof.joint;
+      const double shift = (after[k] - before[k]).norm();
+      if (below) {
+        some_moved |= shift > 1e-3;
+      } else {
+        EXPECT_LT(shift, 1e-12) << dof.name << " moved keypoint " << KeypointName(k);
+      }
+    }
+    EXPECT_TRUE(some_moved) << dof.name << " moved nothing";
+  }
+}
+
+TEST(HandModelTest, FlexionCurlsTowardsThePalmAndAbductionTowardsTheThumb) {
+  for (const HandModel* model : {&RightHand(), &LeftHand()}) {
+    HandPose rest;
+    rest.handedness = model->handedness();
+    const Keypoints3d open = model->KeypointsOf(rest);
+    const Eigen::Vector3d radial =
+        (model->bind_joint_positions()[Index(Joint::kIndexProximal)] - model->bind_joint_positions()[Index(Joint::kLittleProximal)]).normalized();
+    for (const char* finger : {"index", "middle", "ring", "little"}) {
+      HandPose bent = rest;
+      bent.angles[DofFromString(std::string(finger) + "_mcp_flex")] = 0.8;
+      const int tip = DofFromString(std::string(finger) + "_mcp_flex") + 3;  // index: dof 5, tip keypoint 8
+      const Keypoints3d curled = model->KeypointsOf(bent);
+      EXPECT_LT(curled[tip].z(), open[tip].z() - 0.02) << finger << ": the palm is on the hand frame's -z side";
+      HandPose spread = rest;
+      spread.angles[DofFromString(std::string(finger) + "_mcp_abd")] = 0.25;
+      EXPECT_GT((model->KeypointsOf(spread)[tip] - open[tip]).dot(radial), 0.005) << finger;
+    }
+  }
+}
+
+TEST(HandModelTest, LeftHandIsTheMirrorOfTheRightInEveryPose) {
+  Random random(testing::kTestSeed);
+  const Eigen::Vector3d flip(1.0, -1.0, 1.0);  // the hand frame's y is radial on the right, ulnar on the left
+  // The two meshes are mirror images to within a few millimetres, and their bones' directions
+  // differ slightly, so posed keypoints may drift apart by a few millimetres more; a flipped
+  // axis would move them by centimetres.
+  std::array<double, kNumKeypoints> at_rest;
+  {
+    HandPose right, left;
+    left.handedness = Handedness::kLeft;
+    const Keypoints3d r = RightHand().KeypointsOf(right), l = LeftHand().KeypointsOf(left);
+    for (int k = 0; k < kNumKeypoints; ++k) {
+      at_rest[k] = (l[k] - r[k].cwiseProduct(flip)).norm();
+      EXPECT_LT(at_rest[k], 0.005) << KeypointName(k);
+    }
+  }
+  for (int trial = 0; trial < 20; ++trial) {
+    HandPose right;
+    right.angles = RandomArticulation(random);
+    HandPose left = right;
+    left.handedness = Handedness::kLeft;
+    const Keypoints3d r = RightHand().KeypointsOf(right), l = LeftHand().KeypointsOf(left);
+    for (int k = 0; k < kNumKeypoints; ++k) {
+      EXPECT_LT((l[k] - r[k].cwiseProduct(flip)).norm(), at_rest[k] + 0.006) << KeypointName(k);
+    }
+  }
+}
+
+TEST(HandModelTest, PoseOfTheOtherHandIsRefused) {
+  HandPose left;
+  left.handedness = Handedness::kLeft;
+  EXPECT_THROW(RightHand().KeypointsOf(left), Error);
+}
+
+TEST(HandModelTest, MissingOrAlteredAssetGivesAClearError) {
+  const auto dir = testing::ScratchDir();
+  try {
+    HandModel::Load(Handedness::kRight, dir);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("setup"), std::string::npos) << e.what();
+  }
+  std::vector<uint8_t> bytes = ReadFileBytes(DefaultAssetDir() / "right.glb");
+  bytes[bytes.size() / 2] ^= 1;
+  WriteFileAtomic(dir / "right.glb", bytes);
+  try {
+    HandModel::Load(Handedness::kRight, dir);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("sha256"), std::string::npos) << e.what();
+  }
+}
+
+TEST(HandModelTest, GarbageAndForeignGlbAreRefused) {
+  const std::vector<uint8_t> garbage(1000, 7);
+  EXPECT_THROW(HandModel::FromGlb(garbage, Handedness::kRight, "garbage.glb"), Error);
+  std::vector<uint8_t> truncated = ReadFileBytes(DefaultAssetDir() / "right.glb");
+  truncated.resize(truncated.size() / 3);
+  EXPECT_THROW(HandModel::FromGlb(truncated, Handedness::kRight, "truncated.glb"), Error);
+}
+
+}  // namespace
+}  // namespace nphand

@@ -1,0 +1,32 @@
+#include "testing/testing.h"
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+namespace nphand::testing {
+
+const HandModel& RightHand() {
+  static const HandModel model = HandModel::Load(Handedness::kRight);
+  return model;
+}
+
+const HandModel& LeftHand() {
+  static const HandModel model = HandModel::Load(Handedness::kLeft);
+  return model;
+}
+
+std::filesystem::path ScratchDir() {
+  const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = std::string(info->test_suite_name()) + "." + info->name();
+  for (char& c : name) {
+    if (c == '/') c = '_';
+  }
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("nphand_test_" + std::to_string(::getpid())) / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace nphand::testing

@@ -1,0 +1,20 @@
+// Test support shared by every test binary.
+#pragma once
+
+#include <filesystem>
+
+#include "nphand/model/hand_model.h"
+
+namespace nphand::testing {
+
+// The hand models, loaded once per test binary from the set-up cache.
+const HandModel& RightHand();
+const HandModel& LeftHand();
+
+// A fresh empty folder for the running test, under the system's temporary folder.
+std::filesystem::path ScratchDir();
+
+// The seed each test should use: fixed, and printed by the test main on failure.
+inline constexpr uint64_t kTestSeed = 20131108;
+
+}  // namespace nphand::testing
