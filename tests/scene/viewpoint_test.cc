@@ -47,3 +47,34 @@ TEST(ViewpointTest, CentredWristPutsTheCentreOnTheOpticalAxis) {
 
 }  // namespace
 }  // namespace nphand
+
+namespace nphand {
+namespace {
+
+TEST(ViewSphereTest, DirectionsAreUnitDistinctAndCoverTheSphereEvenly) {
+  const std::vector<Eigen::Vector3d> directions = ViewSphereDirections(648);
+  ASSERT_EQ(directions.size(), 648u);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& d : directions) {
+    EXPECT_NEAR(d.norm(), 1.0, 1e-12);
+    mean += d / 648.0;
+  }
+  EXPECT_LT(mean.norm(), 1e-3) << "no side of the hand is favoured";
+  const ViewSphereCoverage coverage = MeasureCoverage(directions);
+  // 648 equal caps of 4 pi / 648 sr have an angular radius of 4.5 degrees; a good lattice
+  // leaves no point much further than that from a direction.
+  EXPECT_GT(coverage.covering_radius_deg, 4.4);
+  EXPECT_LT(coverage.covering_radius_deg, 6.0);
+  EXPECT_LT(coverage.max_neighbour_deg, 9.0);
+}
+
+TEST(ViewSphereTest, ViewpointFromDirectionInvertsViewDirection) {
+  for (const Eigen::Vector3d& d : ViewSphereDirections(100)) {
+    const Viewpoint v = ViewpointFromDirection(3.0 * d, 0.4);
+    EXPECT_LT((ViewDirection(v) - d).norm(), 1e-12);
+    EXPECT_EQ(v.roll, 0.4);
+  }
+}
+
+}  // namespace
+}  // namespace nphand

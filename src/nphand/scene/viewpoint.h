@@ -1,6 +1,8 @@
 // Viewpoints: where the camera looks at the hand from.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "nphand/util/random.h"
@@ -21,6 +23,19 @@ Viewpoint RandomViewpoint(Random& random);
 
 // The unit direction from the hand towards the camera, in the hand frame.
 Eigen::Vector3d ViewDirection(const Viewpoint& viewpoint);
+// The viewpoint whose ViewDirection is `direction` (any non-zero vector), with `roll`.
+Viewpoint ViewpointFromDirection(const Eigen::Vector3d& direction, double roll = 0.0);
+
+// `count` directions spread uniformly over the sphere (the Fibonacci lattice: equal-area
+// bands, golden-angle turns), deterministic. The paper samples 648.
+std::vector<Eigen::Vector3d> ViewSphereDirections(int count);
+
+struct ViewSphereCoverage {
+  double max_neighbour_deg = 0.0;   // the largest angle from a direction to its nearest other one
+  double covering_radius_deg = 0.0; // the largest angle from any point of the sphere to the
+                                    // nearest direction (estimated on a dense probe lattice)
+};
+ViewSphereCoverage MeasureCoverage(const std::vector<Eigen::Vector3d>& directions);
 
 // camera_from_hand for a camera placed along ViewDirection and looking back at the hand,
 // the fingers (hand +x) pointing up in the image at roll 0, then rolled about the optical

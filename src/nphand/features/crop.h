@@ -1,0 +1,29 @@
+// The hand segment as the features see it: a binary hand mask, wherever it came from (a
+// rendered label image or a skin segmentation of a camera frame), cropped to the square
+// around its bounding box with a margin and resampled to a fixed size.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace nphand {
+
+struct CropOptions {
+  int size = 64;         // side of the resampled crop, pixels
+  double margin = 0.1;   // added on each side, as a fraction of the bounding box's longer side
+
+  bool Check(std::string* why) const;
+};
+
+struct HandCrop {
+  cv::Mat image;    // CV_32FC1, size x size, hand coverage in [0, 1]
+  cv::Rect window;  // the square of the source image that was resampled (may extend past it)
+};
+
+// The crop of the non-zero pixels of `mask` (CV_8UC1); std::nullopt when the mask has none
+// ("no hand"). Throws nphand::Error for a mask of another type or invalid options.
+std::optional<HandCrop> CropHand(const cv::Mat& mask, const CropOptions& options = {});
+
+}  // namespace nphand
