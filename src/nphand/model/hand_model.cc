@@ -102,7 +102,9 @@ HandModel HandModel::FromGlb(std::span<const uint8_t> glb, Handedness handedness
   // Map the skin's joint slots to our joint order by name.
   std::array<int, kNumJoints> slot_to_joint{};
   for (int slot = 0; slot < kNumJoints; ++slot) {
-    const std::string& name = gltf.nodes.at(skin.joints[slot]).name;
+    NPHAND_THROW_CHECK(skin.joints[slot] >= 0 && skin.joints[slot] < static_cast<int>(gltf.nodes.size()), source,
+                       ": skin joint ", slot, " names a missing node");
+    const std::string& name = gltf.nodes[skin.joints[slot]].name;
     int joint = -1;
     for (int j = 0; j < kNumJoints; ++j) {
       if (name == JointName(static_cast<Joint>(j))) joint = j;
@@ -176,9 +178,14 @@ HandModel HandModel::FromGlb(std::span<const uint8_t> glb, Handedness handedness
       ReadAccessor<float>(gltf, attribute("NORMAL"), TINYGLTF_COMPONENT_TYPE_FLOAT, 3, source, "NORMAL");
   const std::vector<float> weights =
       ReadAccessor<float>(gltf, attribute("WEIGHTS_0"), TINYGLTF_COMPONENT_TYPE_FLOAT, 4, source, "WEIGHTS_0");
+  const auto component_type = [&](int accessor, const char* what) {
+    NPHAND_THROW_CHECK(accessor >= 0 && accessor < static_cast<int>(gltf.accessors.size()), source, ": ", what,
+                       " accessor missing");
+    return gltf.accessors[accessor].componentType;
+  };
   const int joints_accessor = attribute("JOINTS_0");
   std::vector<uint16_t> joints;
-  if (gltf.accessors.at(joints_accessor).componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
+  if (component_type(joints_accessor, "JOINTS_0") == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) {
     const std::vector<uint8_t> narrow = ReadAccessor<uint8_t>(
         gltf, joints_accessor, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, 4, source, "JOINTS_0");
     joints.assign(narrow.begin(), narrow.end());
@@ -209,9 +216,8 @@ HandModel HandModel::FromGlb(std::span<const uint8_t> glb, Handedness handedness
     }
   }
 
-  NPHAND_THROW_CHECK(primitive->indices >= 0, source, ": mesh is not indexed");
   std::vector<uint32_t> indices;
-  if (gltf.accessors.at(primitive->indices).componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
+  if (component_type(primitive->indices, "indices") == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
     const std::vector<uint16_t> narrow = ReadAccessor<uint16_t>(
         gltf, primitive->indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, 1, source, "indices");
     indices.assign(narrow.begin(), narrow.end());
