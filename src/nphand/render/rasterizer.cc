@@ -13,8 +13,9 @@ namespace {
 constexpr int kSubpixelBits = 8;
 constexpr int64_t kOne = int64_t{1} << kSubpixelBits;
 constexpr int64_t kHalf = kOne / 2;
-// Projected coordinates beyond this many pixels are not drawn (they overflow nothing, but
-// such triangles are degenerate views of surfaces grazing the camera plane).
+// Triangles with a vertex projected beyond this many pixels are not drawn: it keeps the
+// edge functions' products (2^31 x 2^31 at most) within int64, and such vertices only come
+// from surfaces grazing the camera plane.
 constexpr double kMaxCoordinate = double{1 << 22};
 
 struct FixedVertex {
