@@ -21,8 +21,8 @@ cv::Mat ContourDistance(const cv::Mat& edges);
 std::vector<float> DistanceTransformFeature(const cv::Mat& crop, int grid = 32);
 
 // The mean, over the contour pixels of `edges_a`, of the distance to the nearest contour
-// pixel of the other crop (its ContourDistance, `distance_b`), in crop sides. Symmetrise by
-// averaging both directions. 1 when `edges_a` is empty.
+// pixel of the other crop (its ContourDistance, `distance_b`), in crop sides; 1 when
+// `edges_a` is empty. Directed: average it both ways for a symmetric distance.
 double ChamferDistance(const cv::Mat& edges_a, const cv::Mat& distance_b);
 
 }  // namespace nphand

@@ -52,7 +52,8 @@ std::vector<float> ComputeHog(const cv::Mat& crop, const HogOptions& options) {
   const double range = options.signed_orientation ? 2.0 * std::numbers::pi : std::numbers::pi;
   const double bins_per_radian = bins / range;
 
-  std::vector<double> histogram(static_cast<size_t>(cells) * cells * bins, 0.0);
+  // All levels in one vector: the finest first, then (pyramid) each coarser one.
+  std::vector<double> all(static_cast<size_t>(options.Dimension()), 0.0);
   for (int y = 0; y < side; ++y) {
     const float* row = crop.ptr<float>(y);
     const float* up = crop.ptr<float>(std::max(0, y - 1));
@@ -67,31 +68,28 @@ std::vector<float> ComputeHog(const cv::Mat& crop, const HogOptions& options) {
       const double position = angle * bins_per_radian;
       const int lower = static_cast<int>(std::floor(position)) % bins;
       const double upper_share = position - std::floor(position);
-      double* cell = &histogram[(static_cast<size_t>(y / cell_side) * cells + x / cell_side) * bins];
+      double* cell = &all[(static_cast<size_t>(y / cell_side) * cells + x / cell_side) * bins];
       cell[lower] += magnitude * (1.0 - upper_share);
       cell[(lower + 1) % bins] += magnitude * upper_share;
     }
   }
 
   // Coarser levels: each cell the sum of the 2 x 2 cells below it.
-  std::vector<std::vector<double>> levels = {std::move(histogram)};
   if (options.pyramid) {
+    size_t fine = 0, coarse = static_cast<size_t>(cells) * cells * bins;
     for (int c = cells; c % 2 == 0; c /= 2) {
-      const std::vector<double>& fine = levels.back();
-      std::vector<double> coarse(static_cast<size_t>(c / 2) * (c / 2) * bins, 0.0);
       for (int cy = 0; cy < c; ++cy) {
         for (int cx = 0; cx < c; ++cx) {
           for (int b = 0; b < bins; ++b) {
-            coarse[((cy / 2) * (c / 2) + cx / 2) * bins + b] += fine[(cy * c + cx) * bins + b];
+            all[coarse + ((cy / 2) * (c / 2) + cx / 2) * bins + b] += all[fine + (cy * c + cx) * bins + b];
           }
         }
       }
-      levels.push_back(std::move(coarse));
+      fine = coarse;
+      coarse += static_cast<size_t>(c / 2) * (c / 2) * bins;
     }
   }
 
-  std::vector<double> all;
-  for (const auto& level : levels) all.insert(all.end(), level.begin(), level.end());
   if (options.normalization == HogNormalization::kGlobalL2) {
     double norm = 0.0;
     for (double v : all) norm += v * v;
