@@ -15,6 +15,10 @@ void AddRenderCommand(CLI::App& app, nphand::RenderCommandOptions& o) {
   CLI::App* cmd = app.add_subcommand("render", "Render a posed hand (and an object) to PNG: RGB, labels, depth, keypoints");
   cmd->add_option("--hand", o.hand, "Which hand: right or left")->capture_default_str();
   cmd->add_option("--pose", o.pose, "Named articulation: rest, relaxed, fist, point, pinch")->capture_default_str();
+  cmd->add_option("--grasp", o.grasp,
+                  "A grasp of the GRASP taxonomy (e.g. large_diameter; replaces --pose and --object), "
+                  "or 'all' for a contact sheet of the 33");
+  cmd->add_option("--step", o.step, "The grasp's time step, 0 (pre-shape) to 4 (grasp)")->capture_default_str();
   cmd->add_option("--angle", o.angles, "Override a joint angle, NAME=DEGREES (e.g. index_pip_flex=45); repeatable");
   cmd->add_option("--azimuth", o.azimuth_deg, "Viewpoint azimuth, degrees (0: palm, 180: back)")->capture_default_str();
   cmd->add_option("--elevation", o.elevation_deg, "Viewpoint elevation, degrees")->capture_default_str();

@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "nphand/render/draw.h"
 #include "nphand/render/renderer.h"
@@ -56,6 +57,10 @@ bool RenderCommandOptions::Check(std::string* why) const {
     *why = "--object-at and --object-rotate take three values";
     return false;
   }
+  if (step < 0 || step >= kGraspSteps) {
+    *why = "--step must be between 0 and " + std::to_string(kGraspSteps - 1);
+    return false;
+  }
   if (!object.empty() && static_cast<int>(object_size.size()) != ObjectSizeCount(ObjectShapeFromString(object))) {
     *why = "--object-size for a " + object + " takes " + ObjectSizeMeaning(ObjectShapeFromString(object));
     return false;
@@ -63,30 +68,70 @@ bool RenderCommandOptions::Check(std::string* why) const {
   return Intrinsics::FromFieldOfView(width, height, fov_deg * kRadPerDeg).Check(why);
 }
 
+namespace {
+
+Scene SceneOf(const RenderCommandOptions& options, const HandModel& model, const Viewpoint& view) {
+  std::string why;
+  Scene scene;
+  scene.hand.handedness = model.handedness();
+  scene.hand.camera_from_hand = CameraFromHand(view);
+  if (!options.grasp.empty()) {
+    const Grasp grasp = MakeGrasp(model, GraspByName(options.grasp));
+    scene.hand.angles = grasp.steps[options.step];
+    scene.objects = {grasp.object};
+  } else {
+    scene.hand.angles = ArticulationOf(options);
+    if (!options.object.empty()) {
+      SceneObject object;
+      object.spec.shape = ObjectShapeFromString(options.object);
+      std::copy(options.object_size.begin(), options.object_size.end(), object.spec.size.begin());
+      NPHAND_THROW_CHECK(object.spec.Check(&why), "render: ", why);
+      object.hand_from_object.translation() =
+          Eigen::Vector3d(options.object_at[0], options.object_at[1], options.object_at[2]);
+      object.hand_from_object.linear() =
+          AxisAngle(Eigen::Vector3d::UnitZ(), options.object_rotate_deg[2] * kRadPerDeg) *
+          AxisAngle(Eigen::Vector3d::UnitY(), options.object_rotate_deg[1] * kRadPerDeg) *
+          AxisAngle(Eigen::Vector3d::UnitX(), options.object_rotate_deg[0] * kRadPerDeg);
+      scene.objects.push_back(object);
+    }
+  }
+  scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, model.bind_centre(), options.distance);
+  return scene;
+}
+
+// All 33 grasps, one tile each, named, in the taxonomy's order.
+RenderCommandResult RunGraspSheet(const RenderCommandOptions& options, const HandModel& model, const Viewpoint& view) {
+  const int tile = 256, columns = 6, rows = (kNumGrasps + columns - 1) / columns;
+  cv::Mat sheet(rows * tile, columns * tile, CV_8UC3, cv::Scalar(40, 40, 40));
+  const Intrinsics intrinsics = Intrinsics::FromFieldOfView(tile, tile, options.fov_deg * kRadPerDeg);
+  Renderer renderer(model);
+  RenderCommandOptions one = options;
+  for (int i = 0; i < kNumGrasps; ++i) {
+    one.grasp = GraspTaxonomy()[i].name;
+    const RenderedImages images = renderer.Render(SceneOf(one, model, view), intrinsics);
+    cv::Mat cell = sheet(cv::Rect((i % columns) * tile, (i / columns) * tile, tile, tile));
+    images.rgb.copyTo(cell);
+    cv::putText(cell, std::to_string(i + 1) + " " + GraspTaxonomy()[i].name, {6, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  }
+  std::filesystem::create_directories(options.out_dir);
+  const std::filesystem::path path =
+      options.out_dir / (options.name + "_grasps_step" + std::to_string(options.step) + ".png");
+  WriteImageAtomic(path, sheet);
+  RenderCommandResult result;
+  result.files.push_back(path);
+  return result;
+}
+
+}  // namespace
+
 RenderCommandResult RunRender(const RenderCommandOptions& options) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "render: ", why);
-  const Handedness handedness = HandednessFromString(options.hand);
-  const HandModel model = HandModel::Load(handedness, options.asset_dir);
-
-  Scene scene;
-  scene.hand.handedness = handedness;
-  scene.hand.angles = ArticulationOf(options);
-  scene.hand.camera_from_hand = CameraFromHand(
-      {options.azimuth_deg * kRadPerDeg, options.elevation_deg * kRadPerDeg, options.roll_deg * kRadPerDeg});
-  scene.wrist_in_camera =
-      CenteredWristPosition(scene.hand.camera_from_hand, model.bind_centre(), options.distance);
-  if (!options.object.empty()) {
-    SceneObject object;
-    object.spec.shape = ObjectShapeFromString(options.object);
-    std::copy(options.object_size.begin(), options.object_size.end(), object.spec.size.begin());
-    NPHAND_THROW_CHECK(object.spec.Check(&why), "render: ", why);
-    object.hand_from_object.translation() = Eigen::Vector3d(options.object_at[0], options.object_at[1], options.object_at[2]);
-    object.hand_from_object.linear() = (AxisAngle(Eigen::Vector3d::UnitZ(), options.object_rotate_deg[2] * kRadPerDeg) *
-                                        AxisAngle(Eigen::Vector3d::UnitY(), options.object_rotate_deg[1] * kRadPerDeg) *
-                                        AxisAngle(Eigen::Vector3d::UnitX(), options.object_rotate_deg[0] * kRadPerDeg));
-    scene.objects.push_back(object);
-  }
+  const HandModel model = HandModel::Load(HandednessFromString(options.hand), options.asset_dir);
+  const Viewpoint view{options.azimuth_deg * kRadPerDeg, options.elevation_deg * kRadPerDeg, options.roll_deg * kRadPerDeg};
+  if (options.grasp == "all") return RunGraspSheet(options, model, view);
+  const Scene scene = SceneOf(options, model, view);
 
   RenderOptions render_options;
   if (!options.background.empty()) {

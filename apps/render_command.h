@@ -7,12 +7,16 @@
 #include <vector>
 
 #include "nphand/model/hand_model.h"
+#include "nphand/scene/grasp.h"
 
 namespace nphand {
 
 struct RenderCommandOptions {
   std::string hand = "right";            // right | left
   std::string pose = "relaxed";          // a named articulation (NamedArticulations())
+  std::string grasp;                     // a grasp of the taxonomy ("large_diameter"), or "all"
+                                         // for a contact sheet; replaces pose and object
+  int step = kGraspSteps - 1;            // which of the grasp's time steps (0: pre-shape)
   std::vector<std::string> angles;       // overrides "index_pip_flex=45" (degrees)
   double azimuth_deg = 0.0;              // viewpoint (scene/viewpoint.h); 0, 0 looks at the palm
   double elevation_deg = 0.0;
@@ -34,7 +38,7 @@ struct RenderCommandOptions {
 };
 
 struct RenderCommandResult {
-  std::vector<std::filesystem::path> files;  // written: rgb, labels, depth, keypoints
+  std::vector<std::filesystem::path> files;  // written: rgb, labels, depth, keypoints (or the sheet)
   int hand_pixels = 0;
   int object_pixels = 0;
 };

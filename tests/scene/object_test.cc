@@ -94,3 +94,35 @@ TEST(ObjectTest, ShapeNamesRoundTrip) {
 
 }  // namespace
 }  // namespace nphand
+
+namespace nphand {
+namespace {
+
+TEST(ObjectTest, SignedDistanceIsZeroOnTheSurfaceAndNegativeInside) {
+  for (const ShapeCase& c : Cases()) {
+    ObjectSpec fine = c.spec;
+    fine.segments = 256;
+    // Every vertex of a fine mesh lies on the exact surface.
+    for (const Eigen::Vector3f& v : MakeObjectMesh(fine).vertices) {
+      ASSERT_NEAR(SignedDistance(c.spec, v.cast<double>()), 0.0, 1e-6) << ToString(c.spec.shape);
+    }
+    // Moving out along the normal by d gives distance d; moving in gives -d on smooth
+    // shapes (at a sharp edge the nearest surface is another face).
+    const bool smooth = c.spec.shape == ObjectShape::kSphere || c.spec.shape == ObjectShape::kTorus ||
+                        c.spec.shape == ObjectShape::kStick;
+    const TriangleMesh mesh = MakeObjectMesh(fine);
+    for (size_t v = 0; v < mesh.vertices.size(); v += 37) {
+      const Eigen::Vector3d p = mesh.vertices[v].cast<double>(), n = mesh.normals[v].cast<double>();
+      EXPECT_NEAR(SignedDistance(c.spec, p + 0.001 * n), 0.001, 2e-5) << ToString(c.spec.shape);
+      if (smooth) {
+        EXPECT_NEAR(SignedDistance(c.spec, p - 0.0005 * n), -0.0005, 2e-5) << ToString(c.spec.shape);
+      }
+    }
+    // The centre is inside every shape but the torus, whose hole it is.
+    EXPECT_EQ(SignedDistance(c.spec, Eigen::Vector3d::Zero()) < 0.0, c.spec.shape != ObjectShape::kTorus);
+  }
+  EXPECT_DOUBLE_EQ(SignedDistance({ObjectShape::kSphere, {0.04, 0, 0}, 32}, Eigen::Vector3d(0.1, 0, 0)), 0.06);
+}
+
+}  // namespace
+}  // namespace nphand

@@ -242,6 +242,18 @@ Eigen::Vector3d HandModel::bind_centre() const {
   return centre / kNumJoints;
 }
 
+std::vector<int> HandModel::VerticesMovedBy(int joint, float min_weight) const {
+  std::vector<int> vertices;
+  for (size_t v = 0; v < skin_joints_.size(); ++v) {
+    float weight = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      if (IsInSubtree(skin_joints_[v][k], joint)) weight += skin_weights_[v][k];
+    }
+    if (weight >= min_weight) vertices.push_back(static_cast<int>(v));
+  }
+  return vertices;
+}
+
 void HandModel::CheckHandedness(const HandPose& pose) const {
   NPHAND_THROW_CHECK(pose.handedness == handedness_, "a ", ToString(pose.handedness),
                      " hand pose was given to the ", ToString(handedness_), " hand model");

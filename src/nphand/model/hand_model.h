@@ -55,6 +55,10 @@ class HandModel {
   // dorsal normal), in the hand frame.
   const Eigen::Matrix3d& bind_joint_axes(int joint) const { return bind_axes_[joint]; }
 
+  // The vertices whose skin weights on `joint` and the joints below it sum to at least
+  // `min_weight`: the skin that moves with that joint.
+  std::vector<int> VerticesMovedBy(int joint, float min_weight = 0.5f) const;
+
   // Forward kinematics: each joint's posed frame in the hand frame (before camera_from_hand).
   std::array<Eigen::Isometry3d, kNumJoints> JointTransforms(const JointAngles& angles) const;
   // Posed joint positions and keypoints in the camera orientation, wrist at the origin.

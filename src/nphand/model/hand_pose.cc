@@ -38,30 +38,16 @@ const std::array<DofInfo, kNumDofs> kDofs = {{
     {"little_dip_flex", Joint::kLittleDistal, DofAxis::kFlexion, Deg(-10), Deg(80)},
 }};
 
-// Builds angles from per-finger values in degrees: thumb (cmc flex, abd, roll, mcp, ip) and
-// for each finger (mcp flex, mcp abd, pip, dip).
-JointAngles FromDegrees(std::array<double, 5> thumb, std::array<double, 4> index,
-                        std::array<double, 4> middle, std::array<double, 4> ring,
-                        std::array<double, 4> little) {
-  JointAngles angles{};
-  int k = 0;
-  for (double v : thumb) angles[k++] = Deg(v);
-  for (const auto& finger : {index, middle, ring, little}) {
-    for (double v : finger) angles[k++] = Deg(v);
-  }
-  return angles;
-}
-
 const std::map<std::string, JointAngles>& Articulations() {
   static const std::map<std::string, JointAngles> kArticulations = {
       {"rest", JointAngles{}},
-      {"relaxed", FromDegrees({15, 10, 15, 15, 15}, {20, 3, 25, 10}, {25, 0, 30, 12},
+      {"relaxed", AnglesFromDegrees({15, 10, 15, 15, 15}, {20, 3, 25, 10}, {25, 0, 30, 12},
                               {30, -3, 35, 14}, {35, -6, 40, 15})},
-      {"fist", FromDegrees({30, -20, 50, 30, 20}, {88, 0, 90, 60}, {88, 0, 90, 60},
+      {"fist", AnglesFromDegrees({30, -20, 50, 30, 20}, {88, 0, 90, 60}, {88, 0, 90, 60},
                            {88, 0, 90, 60}, {88, 0, 90, 60})},
-      {"point", FromDegrees({30, -20, 50, 30, 20}, {0, 0, 0, 0}, {88, 0, 90, 60}, {88, 0, 90, 60},
+      {"point", AnglesFromDegrees({30, -20, 50, 30, 20}, {0, 0, 0, 0}, {88, 0, 90, 60}, {88, 0, 90, 60},
                             {88, 0, 90, 60})},
-      {"pinch", FromDegrees({35, 20, 50, 20, 25}, {45, 0, 45, 25}, {20, 0, 20, 10},
+      {"pinch", AnglesFromDegrees({35, 20, 50, 20, 25}, {45, 0, 45, 25}, {20, 0, 20, 10},
                             {15, 0, 15, 10}, {10, -5, 10, 5})},
   };
   return kArticulations;
@@ -103,6 +89,18 @@ JointAngles ClampToLimits(const JointAngles& angles) {
     clamped[i] = std::isnan(angles[i]) ? 0.0 : std::clamp(angles[i], kDofs[i].min_rad, kDofs[i].max_rad);
   }
   return clamped;
+}
+
+JointAngles AnglesFromDegrees(const std::array<double, 5>& thumb, const std::array<double, 4>& index,
+                              const std::array<double, 4>& middle, const std::array<double, 4>& ring,
+                              const std::array<double, 4>& little) {
+  JointAngles angles{};
+  int k = 0;
+  for (double v : thumb) angles[k++] = Deg(v);
+  for (const auto& finger : {index, middle, ring, little}) {
+    for (double v : finger) angles[k++] = Deg(v);
+  }
+  return angles;
 }
 
 JointAngles RandomArticulation(Random& random) {

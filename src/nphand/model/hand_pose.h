@@ -64,6 +64,12 @@ struct HandPose {
 // The angles moved into their limits.
 JointAngles ClampToLimits(const JointAngles& angles);
 
+// Angles from degrees, per digit: thumb {CMC flexion, CMC abduction, CMC roll, MCP, IP};
+// each finger {MCP flexion, MCP abduction, PIP, DIP}.
+JointAngles AnglesFromDegrees(const std::array<double, 5>& thumb, const std::array<double, 4>& index,
+                              const std::array<double, 4>& middle, const std::array<double, 4>& ring,
+                              const std::array<double, 4>& little);
+
 // Angles drawn uniformly within their limits.
 JointAngles RandomArticulation(Random& random);
 

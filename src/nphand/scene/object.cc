@@ -171,4 +171,31 @@ TriangleMesh MakeObjectMesh(const ObjectSpec& spec) {
   return mesh;
 }
 
+double SignedDistance(const ObjectSpec& spec, const Eigen::Vector3d& p) {
+  // A capped cylinder of radius r and half height h about z.
+  const auto cylinder = [&p](double r, double h) {
+    const Eigen::Vector2d d(p.head<2>().norm() - r, std::abs(p.z()) - h);
+    return std::min(d.maxCoeff(), 0.0) + d.cwiseMax(0.0).norm();
+  };
+  switch (spec.shape) {
+    case ObjectShape::kSphere:
+      return p.norm() - spec.size[0];
+    case ObjectShape::kCylinder:
+    case ObjectShape::kDisk:
+      return cylinder(spec.size[0], spec.size[1] / 2.0);
+    case ObjectShape::kBox: {
+      const Eigen::Vector3d q = p.cwiseAbs() - Eigen::Vector3d(spec.size[0], spec.size[1], spec.size[2]) / 2.0;
+      return std::min(q.maxCoeff(), 0.0) + q.cwiseMax(0.0).norm();
+    }
+    case ObjectShape::kTorus:
+      return Eigen::Vector2d(p.head<2>().norm() - spec.size[0], p.z()).norm() - spec.size[1];
+    case ObjectShape::kStick: {
+      const double half = spec.size[1] / 2.0 - spec.size[0];
+      return Eigen::Vector3d(p.x(), p.y(), p.z() - std::clamp(p.z(), -half, half)).norm() - spec.size[0];
+    }
+  }
+  NPHAND_CHECK(false, "unknown object shape");
+  return 0.0;
+}
+
 }  // namespace nphand

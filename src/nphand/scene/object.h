@@ -47,6 +47,11 @@ struct TriangleMesh {
 // fails Check.
 TriangleMesh MakeObjectMesh(const ObjectSpec& spec);
 
+// The signed distance (metres) from `point_in_object` to the object's exact surface:
+// negative inside. Analytic, so it does not depend on the mesh's tessellation (whose
+// flat faces lie inside the true surface by at most r (1 - cos(pi / segments))).
+double SignedDistance(const ObjectSpec& spec, const Eigen::Vector3d& point_in_object);
+
 // An object placed in the hand frame, so that it moves with the hand.
 struct SceneObject {
   ObjectSpec spec;
