@@ -22,6 +22,11 @@ render --name bar_grip --pose fist --object cylinder --object-size 0.015,0.16 \
   --object-at 0.075,0.0,-0.03 --object-rotate 90,0,0 --azimuth 200 --elevation 10
 render --name left_pinch --hand left --pose pinch --azimuth 10 --elevation -10
 
+echo "demo: the 33 grasps of the GRASP taxonomy, pre-shape and final grasp"
+render --name taxonomy --grasp all --azimuth 25 --elevation 25 --step 0
+render --name taxonomy --grasp all --azimuth 25 --elevation 25
+render --name power_sphere --grasp power_sphere --azimuth 30 --elevation 10
+
 echo "demo: renderer speed (label images of 128x128, hand + object, one core)"
 "$nphand" bench render --json | tee "$out/bench_render.json"
 echo "demo: done; images in $out"
