@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/bench_command.h"
+#include "apps/db_command.h"
 #include "apps/render_command.h"
 #include "nphand/util/check.h"
 
@@ -65,6 +66,51 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, bool& json) {
   });
 }
 
+void PrintJson(const nlohmann::json& report, bool json) { std::cout << (json ? report.dump() : report.dump(2)) << "\n"; }
+
+struct DbArgs {
+  nphand::DbBuildCommandOptions build;
+  std::vector<std::filesystem::path> shards;
+  std::filesystem::path merge_out = "out/nphand.db";
+  std::filesystem::path info_path = "out/nphand.db";
+  bool json = false;
+};
+
+void AddDbCommand(CLI::App& app, DbArgs& a) {
+  CLI::App* db = app.add_subcommand("db", "Build, merge and inspect the database of rendered hand views");
+  db->require_subcommand(1);
+  nphand::DatabaseBuildOptions& b = a.build.build;
+  CLI::App* build = db->add_subcommand("build", "Render every grasp, step, object/no object and viewpoint into a database");
+  build->add_option("--out", a.build.out, "Database file to write")->capture_default_str();
+  build->add_option("--grasps", b.grasps, "Taxonomy numbers to include (default: all 33)")->delimiter(',');
+  build->add_option("--directions", b.directions, "Viewing directions on the sphere")->capture_default_str();
+  build->add_option("--image-size", b.image_size, "Rendered image side, pixels")->capture_default_str();
+  build->add_option("--threads", b.threads, "Worker threads (0: all cores)")->capture_default_str();
+  build->add_option("--shard", a.build.shard, "Build part i of N (i/N), to merge later with db merge");
+  build->add_option("--asset-dir", a.build.asset_dir, "Folder holding right.glb")->capture_default_str();
+  build->add_flag("--quiet", a.build.quiet, "No progress line");
+  build->add_flag("--json", a.json, "Print the summary as one JSON object");
+  build->callback([&a]() {
+    const nlohmann::json summary = nphand::RunDbBuild(a.build);
+    if (a.json) {
+      PrintJson(summary, true);
+    } else {
+      std::cout << "wrote " << summary["entries"] << " entries to " << summary["path"].get<std::string>() << " in "
+                << summary["seconds"].get<double>() << " s (" << summary["resumed"] << " resumed, "
+                << summary["no_hand"] << " with the hand hidden)\n";
+    }
+  });
+  CLI::App* merge = db->add_subcommand("merge", "Join the shards of one build into one database");
+  merge->add_option("shards", a.shards, "Shard files")->required();
+  merge->add_option("--out", a.merge_out, "Database file to write")->capture_default_str();
+  merge->add_flag("--json", a.json, "Print one JSON object");
+  merge->callback([&a]() { PrintJson(nphand::RunDbMerge(a.shards, a.merge_out), a.json); });
+  CLI::App* info = db->add_subcommand("info", "What a database file holds (verifies it)");
+  info->add_option("path", a.info_path, "Database file")->capture_default_str();
+  info->add_flag("--json", a.json, "Print one JSON object");
+  info->callback([&a]() { PrintJson(nphand::RunDbInfo(a.info_path), a.json); });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -75,6 +121,8 @@ int main(int argc, char** argv) {
   bool json = false;
   AddRenderCommand(app, render_options);
   AddBenchCommand(app, bench_options, json);
+  DbArgs db_args;
+  AddDbCommand(app, db_args);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -5,6 +5,7 @@ find_package(OpenSSL 3 REQUIRED)        # SHA-256 of the hand asset
 find_package(nlohmann_json 3.11 REQUIRED)
 find_package(CLI11 2.1 REQUIRED)
 find_package(Threads REQUIRED)
+find_package(ZLIB REQUIRED)          # CRC-32 of the database file
 
 # tinygltf: Debian ships the compiled library; its header includes <stb_image.h> unqualified.
 find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h REQUIRED)

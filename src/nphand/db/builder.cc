@@ -1,0 +1,290 @@
+#include "nphand/db/builder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <set>
+#include <thread>
+
+#include "nphand/render/renderer.h"
+#include "nphand/scene/grasp.h"
+#include "nphand/scene/viewpoint.h"
+#include "nphand/util/check.h"
+
+namespace nphand {
+namespace {
+
+constexpr size_t kBatch = 1024;
+
+std::vector<int> GraspsOf(const DatabaseBuildOptions& options) {
+  if (!options.grasps.empty()) return options.grasps;
+  std::vector<int> all(kNumGrasps);
+  for (int i = 0; i < kNumGrasps; ++i) all[i] = i + 1;
+  return all;
+}
+
+std::pair<uint64_t, uint64_t> ShardRange(const DatabaseBuildOptions& options) {
+  const uint64_t total = options.TotalEntries();
+  return {total * options.shard_index / options.shard_count, total * (options.shard_index + 1) / options.shard_count};
+}
+
+// Everything an entry needs that does not change between entries.
+struct Context {
+  const HandModel& hand;
+  const DatabaseBuildOptions& options;
+  std::vector<int> grasp_ids;
+  std::vector<Grasp> grasps;
+  std::vector<Eigen::Vector3d> directions;
+  Intrinsics intrinsics;
+  RecordLayout layout;
+};
+
+// Entry `index` of the enumeration: ((grasp * steps + step) * 2 + with_object) * directions + viewpoint.
+void RenderEntry(const Context& c, uint64_t index, Renderer* renderer, cv::Mat* labels, std::span<uint8_t> record,
+                 uint64_t* no_hand) {
+  const uint64_t directions = c.directions.size();
+  const int view = static_cast<int>(index % directions);
+  const bool with_object = (index / directions) % 2 == 1;
+  const int step = static_cast<int>((index / directions / 2) % kGraspSteps);
+  const size_t g = index / directions / 2 / kGraspSteps;
+  const Grasp& grasp = c.grasps[g];
+
+  Scene scene;
+  scene.hand.handedness = c.hand.handedness();
+  scene.hand.angles = grasp.steps[step];
+  scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(c.directions[view]));
+  scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, c.hand.bind_centre(), c.options.distance);
+  if (with_object) scene.objects = {grasp.object};
+  renderer->RenderLabels(scene, c.intrinsics, labels);
+
+  Entry entry;
+  entry.meta = {static_cast<uint8_t>(c.grasp_ids[g]), static_cast<uint8_t>(step), with_object, false,
+                static_cast<uint16_t>(view)};
+  entry.pose = ToPoseVector(scene.hand);
+  entry.angles = scene.hand.angles;
+  entry.keypoints = c.hand.KeypointsOf(scene.hand);
+  const std::optional<HandCrop> crop =
+      CropHand(*labels == static_cast<int>(PixelLabel::kHand), {kCropBitsSide, c.options.crop_margin});
+  if (crop.has_value()) {
+    entry.meta.has_hand = true;
+    entry.hog = ComputeHog(crop->image, c.options.hog);
+    entry.crop = crop->image >= 0.5f;
+  } else {
+    ++*no_hand;
+    entry.hog.assign(c.layout.hog_dimension, 0.0f);
+    entry.crop = cv::Mat::zeros(kCropBitsSide, kCropBitsSide, CV_8UC1);
+  }
+  EncodeEntry(entry, c.layout, record);
+}
+
+std::string Clock(double seconds) {
+  const int s = static_cast<int>(std::lround(std::max(0.0, seconds)));
+  char text[32];
+  std::snprintf(text, sizeof(text), "%d:%02d", s / 60, s % 60);
+  return text;
+}
+
+}  // namespace
+
+bool DatabaseBuildOptions::Check(std::string* why) const {
+  for (int id : grasps) {
+    if (id < 1 || id > kNumGrasps) {
+      *why = "grasp numbers run from 1 to 33, got " + std::to_string(id);
+      return false;
+    }
+  }
+  if (std::set<int>(grasps.begin(), grasps.end()).size() != grasps.size()) {
+    *why = "a grasp is listed twice";
+    return false;
+  }
+  if (directions < 2 || directions > 65535) {
+    *why = "directions must be between 2 and 65535";
+    return false;
+  }
+  if (shard_count < 1 || shard_index < 0 || shard_index >= shard_count) {
+    *why = "shard must be i/N with 0 <= i < N";
+    return false;
+  }
+  if (threads < 0 || threads > 256) {
+    *why = "threads must be between 0 (all cores) and 256";
+    return false;
+  }
+  const CropOptions crop{kCropBitsSide, crop_margin};
+  const Intrinsics intrinsics = Intrinsics::FromFieldOfView(image_size, image_size, fov_deg * std::numbers::pi / 180.0);
+  if (!(distance > 0.1 && distance < 10.0) || !(fov_deg > 5.0 && fov_deg < 120.0)) {
+    *why = "distance must be within (0.1, 10) metres and the field of view within (5, 120) degrees";
+    return false;
+  }
+  if (kCropBitsSide % hog.cells != 0) {
+    *why = "the HOG cell count must divide the crop side " + std::to_string(kCropBitsSide);
+    return false;
+  }
+  return crop.Check(why) && hog.Check(why) && intrinsics.Check(why);
+}
+
+uint64_t DatabaseBuildOptions::TotalEntries() const {
+  return static_cast<uint64_t>(GraspsOf(*this).size()) * kGraspSteps * 2 * static_cast<uint64_t>(directions);
+}
+
+nlohmann::json DatabaseBuildOptions::Header() const {
+  RecordLayout layout;
+  layout.hog_dimension = hog.Dimension();
+  const auto [begin, end] = ShardRange(*this);
+  nlohmann::json header = {
+      {"format", "nphand database"},
+      {"entries", end - begin},
+      {"total_entries", TotalEntries()},
+      {"record_bytes", layout.RecordBytes()},
+      {"order", "((grasp * steps + step) * 2 + with_object) * viewpoints + viewpoint"},
+      {"grasps", GraspsOf(*this)},
+      {"steps", kGraspSteps},
+      {"viewpoints", directions},
+      {"view_sphere", "fibonacci"},
+      {"hand", "right"},
+      {"hand_asset_sha256", PinnedAssetSha256(Handedness::kRight)},
+      {"render", {{"image_size", image_size}, {"fov_deg", fov_deg}, {"distance_m", distance}}},
+      {"crop", {{"size", kCropBitsSide}, {"margin", crop_margin}}},
+      {"hog",
+       {{"name", hog.Name()},
+        {"cells", hog.cells},
+        {"bins", hog.bins},
+        {"pyramid", hog.pyramid},
+        {"signed", hog.signed_orientation},
+        {"normalization", ToString(hog.normalization)},
+        {"dimension", hog.Dimension()}}},
+  };
+  if (shard_count > 1) {
+    header["shard"] = {{"index", shard_index}, {"count", shard_count}, {"begin", begin}, {"end", end}};
+  }
+  return header;
+}
+
+BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& options, const std::filesystem::path& path,
+                           std::ostream* progress) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "db build: ", why);
+  NPHAND_THROW_CHECK(hand.handedness() == Handedness::kRight, "db build: the database is built from the right hand");
+  const auto start = std::chrono::steady_clock::now();
+
+  Context c{hand, options, GraspsOf(options), {}, ViewSphereDirections(options.directions),
+            Intrinsics::FromFieldOfView(options.image_size, options.image_size, options.fov_deg * std::numbers::pi / 180.0),
+            {}};
+  c.layout.hog_dimension = options.hog.Dimension();
+  for (int id : c.grasp_ids) c.grasps.push_back(MakeGrasp(hand, GraspTaxonomy()[id - 1]));
+
+  const nlohmann::json header = options.Header();
+  std::unique_ptr<DatabaseWriter> writer = DatabaseWriter::OpenForResume(path, header);
+  if (writer == nullptr) writer = std::make_unique<DatabaseWriter>(path, header);
+  const auto [begin, end] = ShardRange(options);
+  BuildSummary summary;
+  summary.resumed = writer->records_written();
+
+  const int threads = options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const size_t record_bytes = c.layout.RecordBytes();
+  std::vector<uint8_t> batch(kBatch * record_bytes);
+  std::vector<uint64_t> no_hand(threads, 0);
+  for (uint64_t first = begin + summary.resumed; first < end; first += kBatch) {
+    const uint64_t count = std::min<uint64_t>(kBatch, end - first);
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t) {
+      workers.emplace_back([&, t]() {
+        Renderer renderer(hand);
+        cv::Mat labels;
+        for (uint64_t i = t; i < count; i += threads) {
+          RenderEntry(c, first + i, &renderer, &labels, std::span<uint8_t>(batch.data() + i * record_bytes, record_bytes),
+                      &no_hand[t]);
+        }
+      });
+    }
+    for (std::thread& worker : workers) worker.join();
+    writer->Append(std::span<const uint8_t>(batch.data(), count * record_bytes));
+    if (progress != nullptr) {
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const uint64_t done = writer->records_written(), made = done - summary.resumed;
+      const double rate = made / std::max(seconds, 1e-9);
+      *progress << "\rdb build: " << done << "/" << (end - begin) << " entries ("
+                << static_cast<int>(100.0 * done / (end - begin)) << "%), " << static_cast<int>(rate)
+                << "/s, ETA " << Clock((end - begin - done) / std::max(rate, 1e-9)) << "   " << std::flush;
+    }
+  }
+  if (progress != nullptr) *progress << "\n";
+  summary.entries = writer->records_written();
+  writer->Finish();
+  for (uint64_t n : no_hand) summary.no_hand += n;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+void MergeDatabases(const std::vector<std::filesystem::path>& shards, const std::filesystem::path& path) {
+  NPHAND_THROW_CHECK(!shards.empty(), "db merge: no shards given");
+  std::vector<Database> parts;
+  for (const auto& shard : shards) {
+    parts.push_back(Database::Open(shard));
+    NPHAND_THROW_CHECK(parts.back().header().contains("shard"), shard.string(), ": not a shard");
+  }
+  std::sort(parts.begin(), parts.end(), [](const Database& a, const Database& b) {
+    return a.header()["shard"]["index"].get<int>() < b.header()["shard"]["index"].get<int>();
+  });
+  const auto common = [](nlohmann::json header) {
+    header.erase("shard");
+    header.erase("entries");
+    return header;
+  };
+  const int count = parts.front().header()["shard"]["count"].get<int>();
+  NPHAND_THROW_CHECK(static_cast<int>(parts.size()) == count, "db merge: ", parts.size(), " shards given, the build has ",
+                     count);
+  uint64_t next = 0;
+  for (int i = 0; i < count; ++i) {
+    const nlohmann::json& shard = parts[i].header()["shard"];
+    NPHAND_THROW_CHECK(common(parts[i].header()) == common(parts.front().header()),
+                       "db merge: the shards come from different builds");
+    NPHAND_THROW_CHECK(shard["index"].get<int>() == i && shard["count"].get<int>() == count &&
+                           shard["begin"].get<uint64_t>() == next,
+                       "db merge: shard ", i, " of ", count, " is missing or repeated");
+    next = shard["end"].get<uint64_t>();
+  }
+  nlohmann::json header = common(parts.front().header());
+  NPHAND_THROW_CHECK(next == header["total_entries"].get<uint64_t>(), "db merge: the shards do not cover the build");
+  header["entries"] = next;
+  // Key order as an unsharded build writes it (nlohmann::json sorts keys, so this matches).
+  std::filesystem::remove(path.string() + ".partial");
+  DatabaseWriter writer(path, header);
+  for (const Database& part : parts) writer.Append(part.Records(0, part.size()));
+  writer.Finish();
+}
+
+nlohmann::json DescribeDatabase(const Database& db) {
+  uint64_t with_object = 0, no_hand = 0;
+  std::set<int> grasps, steps, viewpoints;
+  for (size_t i = 0; i < db.size(); ++i) {
+    const EntryMeta meta = db.Meta(i);
+    with_object += meta.with_object;
+    no_hand += !meta.has_hand;
+    grasps.insert(meta.grasp);
+    steps.insert(meta.step);
+    viewpoints.insert(meta.viewpoint);
+  }
+  const nlohmann::json& header = db.header();
+  nlohmann::json info = {
+      {"entries", db.size()},
+      {"grasps", grasps.size()},
+      {"steps", steps.size()},
+      {"viewpoints", viewpoints.size()},
+      {"with_object", with_object},
+      {"without_object", db.size() - with_object},
+      {"no_hand", no_hand},
+      {"features",
+       {{{"name", header["hog"]["name"]}, {"dimension", header["hog"]["dimension"]}},
+        {{"name", "crop_bits"}, {"dimension", kCropBitsSide * kCropBitsSide}}}},
+      {"record_bytes", db.layout().RecordBytes()},
+      {"file_bytes", db.file_bytes()},
+      {"render", header["render"]},
+      {"crop", header["crop"]},
+  };
+  if (header.contains("shard")) info["shard"] = header["shard"];
+  return info;
+}
+
+}  // namespace nphand

@@ -1,0 +1,60 @@
+// Building the database: every (grasp, step, with/without object, viewpoint) rendered,
+// segmented, cropped and described, in a fixed order, on all cores, deterministically.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nphand/db/database.h"
+#include "nphand/features/crop.h"
+#include "nphand/features/hog.h"
+#include "nphand/model/hand_model.h"
+
+namespace nphand {
+
+struct DatabaseBuildOptions {
+  std::vector<int> grasps;     // taxonomy numbers to include; empty: all 33
+  int directions = 648;        // viewing directions on the sphere (the paper's count)
+  int image_size = 128;        // rendered label image side, pixels
+  double fov_deg = 30.0;       // horizontal field of view
+  double distance = 0.5;       // camera to hand centre, metres
+  double crop_margin = 0.1;    // see CropOptions (the crop side is kCropBitsSide)
+  HogOptions hog;              // the stored descriptor (default 8 x 8 cells x 8 bins)
+  int threads = 0;             // 0: all cores
+  int shard_index = 0;         // build only part shard_index of shard_count (contiguous)
+  int shard_count = 1;
+
+  bool Check(std::string* why) const;
+  // Entries of the whole enumeration (all shards).
+  uint64_t TotalEntries() const;
+  // The header of the file these options build (no build time or machine: same options,
+  // same bytes).
+  nlohmann::json Header() const;
+};
+
+struct BuildSummary {
+  uint64_t entries = 0;        // records in the finished file
+  uint64_t resumed = 0;        // of which were already in a partial file
+  uint64_t no_hand = 0;        // entries whose hand the object hides completely (this run)
+  double seconds = 0.0;
+};
+
+// Builds the database file at `path` (atomically). Resumes "<path>.partial" left by an
+// interrupted build with the same options. Reports progress (count, rate, ETA) to
+// `progress` if not null.
+BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& options,
+                           const std::filesystem::path& path, std::ostream* progress);
+
+// Joins the shards of one build (any order) into the file an unsharded build would have
+// written, byte for byte. Throws nphand::Error if they are not all the shards of one build.
+void MergeDatabases(const std::vector<std::filesystem::path>& shards, const std::filesystem::path& path);
+
+// What a database file holds, for `nphand db info`.
+nlohmann::json DescribeDatabase(const Database& db);
+
+}  // namespace nphand
