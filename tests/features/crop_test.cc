@@ -1,6 +1,10 @@
 #include "nphand/features/crop.h"
 
+#include <cmath>
+#include <numbers>
+
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "nphand/util/check.h"
 
@@ -38,6 +42,29 @@ TEST(CropTest, EmptyMaskIsNoHandAndWrongInputIsRefused) {
   EXPECT_THROW(CropHand(cv::Mat()), Error);
   cv::Mat mask(10, 10, CV_8UC1, cv::Scalar(255));
   EXPECT_THROW(CropHand(mask, {.size = 2, .margin = 0.1}), Error);
+}
+
+}  // namespace
+}  // namespace nphand
+
+namespace nphand {
+namespace {
+
+TEST(CropTest, RollNormalisationUndoesInPlaneRotation) {
+  // An asymmetric shape: a bar with a knob at one end.
+  cv::Mat mask(120, 120, CV_8UC1, cv::Scalar(0));
+  cv::rectangle(mask, cv::Rect(50, 20, 16, 70), cv::Scalar(255), cv::FILLED);
+  cv::circle(mask, {58, 25}, 14, cv::Scalar(255), cv::FILLED);
+  const CropOptions options{.size = 32, .margin = 0.1, .normalize_roll = true};
+  const HandCrop reference = *CropHand(mask, options);
+  for (double degrees : {17.0, 90.0, 161.0, -120.0}) {
+    const double angle = degrees * std::numbers::pi / 180.0;
+    const HandCrop turned = *CropHand(RotateMask(mask, angle), options);
+    // The same crop, up to resampling of the turned pixels.
+    EXPECT_LT(cv::norm(turned.image, reference.image, cv::NORM_L1) / cv::sum(reference.image)[0], 0.15) << degrees;
+    // The recovered turns differ by the applied one.
+    EXPECT_NEAR(std::remainder(reference.roll - turned.roll - angle, 2 * std::numbers::pi), 0.0, 0.05) << degrees;
+  }
 }
 
 }  // namespace

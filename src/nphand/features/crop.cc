@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <opencv2/imgproc.hpp>
 
@@ -21,10 +22,35 @@ bool CropOptions::Check(std::string* why) const {
   return true;
 }
 
-std::optional<HandCrop> CropHand(const cv::Mat& mask, const CropOptions& options) {
+cv::Mat RotateMask(const cv::Mat& mask, double angle) {
+  const int side = static_cast<int>(std::ceil(std::hypot(mask.cols, mask.rows))) + 2;
+  cv::Mat transform = cv::getRotationMatrix2D(cv::Point2f(0.5f * mask.cols, 0.5f * mask.rows),
+                                              angle * 180.0 / std::numbers::pi, 1.0);
+  transform.at<double>(0, 2) += 0.5 * (side - mask.cols);
+  transform.at<double>(1, 2) += 0.5 * (side - mask.rows);
+  cv::Mat turned;
+  cv::warpAffine(mask, turned, transform, cv::Size(side, side), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
+  return turned;
+}
+
+double PrincipalRoll(const cv::Mat& mask) {
+  const cv::Moments m = cv::moments(mask != 0, true);
+  if (m.m00 <= 0.0) return 0.0;
+  // The major axis makes the angle `axis` with +x in image coordinates (y down), i.e. -axis
+  // counter-clockwise as displayed; turning by pi/2 + axis makes it vertical.
+  const double axis = 0.5 * std::atan2(2.0 * m.mu11, m.mu20 - m.mu02);
+  double roll = std::numbers::pi / 2.0 + axis;
+  const cv::Moments turned = cv::moments(RotateMask(mask != 0, roll), true);
+  if (turned.mu03 > 0.0) roll += std::numbers::pi;  // a tail towards the bottom: turn it over
+  return std::remainder(roll, 2.0 * std::numbers::pi);
+}
+
+std::optional<HandCrop> CropHand(const cv::Mat& source, const CropOptions& options) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "crop: ", why);
-  NPHAND_THROW_CHECK(!mask.empty() && mask.type() == CV_8UC1, "crop: the hand mask must be a non-empty 8-bit single-channel image");
+  NPHAND_THROW_CHECK(!source.empty() && source.type() == CV_8UC1, "crop: the hand mask must be a non-empty 8-bit single-channel image");
+  const double roll = options.normalize_roll ? PrincipalRoll(source) : 0.0;
+  const cv::Mat mask = options.normalize_roll ? RotateMask(source, roll) : source;
   const cv::Rect box = cv::boundingRect(mask);
   if (box.area() == 0) return std::nullopt;
 
@@ -44,6 +70,7 @@ std::optional<HandCrop> CropHand(const cv::Mat& mask, const CropOptions& options
 
   HandCrop crop;
   crop.window = window;
+  crop.roll = roll;
   cv::resize(square, crop.image, cv::Size(options.size, options.size), 0, 0,
              side >= options.size ? cv::INTER_AREA : cv::INTER_LINEAR);
   return crop;

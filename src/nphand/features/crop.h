@@ -13,14 +13,28 @@ namespace nphand {
 struct CropOptions {
   int size = 64;         // side of the resampled crop, pixels
   double margin = 0.1;   // added on each side, as a fraction of the bounding box's longer side
+  // Turn the mask first so that its principal axis is vertical (and its third moment along
+  // it negative): in-plane rotation no longer changes the crop, and HandCrop::roll says how
+  // far it was turned.
+  bool normalize_roll = false;
 
   bool Check(std::string* why) const;
 };
 
 struct HandCrop {
   cv::Mat image;    // CV_32FC1, size x size, hand coverage in [0, 1]
-  cv::Rect window;  // the square of the source image that was resampled (may extend past it)
+  cv::Rect window;  // the square of the source image that was resampled (may extend past it);
+                    // with normalize_roll, of the turned mask
+  double roll = 0.0;  // radians the mask was turned counter-clockwise (as displayed) first
 };
+
+// `mask` turned counter-clockwise (as displayed) by `angle` radians about its centre, on a
+// canvas large enough to lose nothing. Nearest-neighbour, so it stays binary.
+cv::Mat RotateMask(const cv::Mat& mask, double angle);
+
+// The counter-clockwise turn that makes the mask's principal axis vertical with its third
+// moment along that axis negative (mass towards the top); 0 for an empty mask.
+double PrincipalRoll(const cv::Mat& mask);
 
 // The crop of the non-zero pixels of `mask` (CV_8UC1); std::nullopt when the mask has none
 // ("no hand"). Throws nphand::Error for a mask of another type or invalid options.
