@@ -7,6 +7,7 @@
 
 #include "apps/bench_command.h"
 #include "apps/db_command.h"
+#include "apps/eval_command.h"
 #include "apps/render_command.h"
 #include "nphand/util/check.h"
 
@@ -86,6 +87,8 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
   build->add_option("--directions", b.directions, "Viewing directions on the sphere")->capture_default_str();
   build->add_option("--image-size", b.image_size, "Rendered image side, pixels")->capture_default_str();
   build->add_option("--threads", b.threads, "Worker threads (0: all cores)")->capture_default_str();
+  build->add_flag("!--raw-roll", b.normalize_roll,
+                  "Describe hands as rendered instead of turned by their principal axis");
   build->add_option("--shard", a.build.shard, "Build part i of N (i/N), to merge later with db merge");
   build->add_option("--asset-dir", a.build.asset_dir, "Folder holding right.glb")->capture_default_str();
   build->add_flag("--quiet", a.build.quiet, "No progress line");
@@ -111,6 +114,34 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
   info->callback([&a]() { PrintJson(nphand::RunDbInfo(a.info_path), a.json); });
 }
 
+void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, bool& json) {
+  CLI::App* eval = app.add_subcommand("eval", "The paper's experiments");
+  eval->require_subcommand(1);
+  CLI::App* features = eval->add_subcommand("features", "Feature study (paper Fig. 4): pose error of feature-space neighbours");
+  nphand::FeatureStudyOptions& s = o.study;
+  features->add_option("--db", o.db, "Database file")->capture_default_str();
+  features->add_option("--queries", s.queries, "Query entries (left out in turn)")->capture_default_str();
+  features->add_option("--neighbours", s.neighbours, "Neighbours per query (K)")->capture_default_str();
+  features->add_option("--seed", s.seed, "Seed of the query sample and rolls")->capture_default_str();
+  features->add_option("--features", s.features,
+                       "Features to compare (default all: joints, hog8x8x8, hog8x8x4, hog8x8x16, hog4x4x8, "
+                       "hog16x16x8, hog8x8x8_pyr, hog8x8x8_nh, dist32)")->delimiter(',');
+  features->add_flag("--roll-queries", s.roll_queries, "Turn each query by a random in-plane angle");
+  features->add_flag("--normalize-roll", s.normalize_roll, "Crop every hand by its principal axis");
+  features->add_option("--out", o.out_dir, "Folder for the JSON and the plot");
+  features->add_option("--name", o.name, "File name of the JSON and the plot")->capture_default_str();
+  features->add_flag("--json", json, "Print one JSON object instead of the table");
+  features->callback([&o, &json]() {
+    o.quiet = json;
+    const nphand::FeatureStudyResult result = nphand::RunEvalFeatures(o);
+    if (json) {
+      std::cout << nphand::ToJson(result).dump() << "\n";
+    } else {
+      std::cout << nphand::FormatTable(result);
+    }
+  });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -123,6 +154,8 @@ int main(int argc, char** argv) {
   AddBenchCommand(app, bench_options, json);
   DbArgs db_args;
   AddDbCommand(app, db_args);
+  nphand::EvalFeaturesCommandOptions eval_options;
+  AddEvalCommand(app, eval_options, json);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

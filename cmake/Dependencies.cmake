@@ -6,6 +6,8 @@ find_package(nlohmann_json 3.11 REQUIRED)
 find_package(CLI11 2.1 REQUIRED)
 find_package(Threads REQUIRED)
 find_package(ZLIB REQUIRED)          # CRC-32 of the database file
+find_package(OpenMP REQUIRED)        # FAISS's config names OpenMP::OpenMP_CXX
+find_package(faiss REQUIRED)         # exact search for the feature study; index backends
 
 # tinygltf: Debian ships the compiled library; its header includes <stb_image.h> unqualified.
 find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h REQUIRED)

@@ -27,6 +27,13 @@ render --name taxonomy --grasp all --azimuth 25 --elevation 25 --step 0
 render --name taxonomy --grasp all --azimuth 25 --elevation 25
 render --name power_sphere --grasp power_sphere --azimuth 30 --elevation 10
 
+echo "demo: the default database (33 grasps x 5 steps x with/without object x 648 viewpoints)"
+"$nphand" db build --out "$root/out/nphand.db"
+"$nphand" db info "$root/out/nphand.db" --json | tee "$out/db_info.json"
+echo
+echo "demo: feature study (paper Fig. 4) on 500 left-out entries, HOG 8x8x8 against pose space"
+"$nphand" eval features --db "$root/out/nphand.db" --queries 500 --features joints,hog8x8x8 --out "$out" --name feature_study
+
 echo "demo: renderer speed (label images of 128x128, hand + object, one core)"
 "$nphand" bench render --json | tee "$out/bench_render.json"
 echo "demo: done; images in $out"

@@ -12,7 +12,7 @@ packages=(
   libfaiss-dev libhnswlib-dev libflann-dev liblz4-dev
   nlohmann-json3-dev libcli11-dev pybind11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libssl-dev zlib1g-dev nodejs
+  libssl-dev zlib1g-dev libopenblas0-pthread nodejs
 )
 
 install_packages() {

@@ -19,7 +19,8 @@ std::filesystem::path WriteSynthetic(const std::filesystem::path& path, int n) {
   std::vector<uint8_t> record(layout.RecordBytes());
   for (int i = 0; i < n; ++i) {
     Entry e;
-    e.meta = {static_cast<uint8_t>(i % 33 + 1), static_cast<uint8_t>(i % 5), i % 2 == 1, true, static_cast<uint16_t>(i)};
+    e.meta = {static_cast<uint8_t>(i % 33 + 1), static_cast<uint8_t>(i % 5), i % 2 == 1, true, static_cast<uint16_t>(i),
+              0.25f * i};
     for (int k = 0; k < kPoseVectorSize; ++k) e.pose[k] = 0.01 * (i + k);
     for (int k = 0; k < kNumDofs; ++k) e.angles[k] = -0.02 * (i + k);
     for (int k = 0; k < kNumKeypoints; ++k) e.keypoints[k] = Eigen::Vector3d(i, k, 0.5);
@@ -54,6 +55,7 @@ TEST(DatabaseTest, RecordsRoundTrip) {
     EXPECT_EQ(meta.step, i % 5);
     EXPECT_EQ(meta.with_object, i % 2 == 1);
     EXPECT_EQ(meta.viewpoint, i);
+    EXPECT_EQ(meta.roll, 0.25f * i);
     EXPECT_FLOAT_EQ(static_cast<float>(db.Pose(i)[3]), 0.01f * (i + 3));
     EXPECT_FLOAT_EQ(static_cast<float>(db.Angles(i)[20]), -0.02f * (i + 20));
     EXPECT_EQ(db.Keypoints(i)[4], Eigen::Vector3d(i, 4, 0.5));

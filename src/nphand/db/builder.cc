@@ -65,11 +65,14 @@ void RenderEntry(const Context& c, uint64_t index, Renderer* renderer, cv::Mat* 
   entry.pose = ToPoseVector(scene.hand);
   entry.angles = scene.hand.angles;
   entry.keypoints = c.hand.KeypointsOf(scene.hand);
-  const std::optional<HandCrop> crop =
-      CropHand(*labels == static_cast<int>(PixelLabel::kHand), {kCropBitsSide, c.options.crop_margin});
+  const cv::Mat mask = *labels == static_cast<int>(PixelLabel::kHand);
+  const std::optional<HandCrop> crop = CropHand(mask, {kCropBitsSide, c.options.crop_margin});
   if (crop.has_value()) {
+    const HandCrop described =
+        c.options.normalize_roll ? *CropHand(mask, {kCropBitsSide, c.options.crop_margin, true}) : *crop;
     entry.meta.has_hand = true;
-    entry.hog = ComputeHog(crop->image, c.options.hog);
+    entry.meta.roll = static_cast<float>(described.roll);
+    entry.hog = ComputeHog(described.image, c.options.hog);
     entry.crop = crop->image >= 0.5f;
   } else {
     ++*no_hand;
@@ -153,6 +156,7 @@ nlohmann::json DatabaseBuildOptions::Header() const {
         {"pyramid", hog.pyramid},
         {"signed", hog.signed_orientation},
         {"normalization", ToString(hog.normalization)},
+        {"normalize_roll", normalize_roll},
         {"dimension", hog.Dimension()}}},
   };
   if (shard_count > 1) {
@@ -282,6 +286,7 @@ nlohmann::json DescribeDatabase(const Database& db) {
       {"file_bytes", db.file_bytes()},
       {"render", header["render"]},
       {"crop", header["crop"]},
+      {"normalize_roll", header["hog"].value("normalize_roll", false)},
   };
   if (header.contains("shard")) info["shard"] = header["shard"];
   return info;

@@ -25,6 +25,10 @@ struct DatabaseBuildOptions {
   double distance = 0.5;       // camera to hand centre, metres
   double crop_margin = 0.1;    // see CropOptions (the crop side is kCropBitsSide)
   HogOptions hog;              // the stored descriptor (default 8 x 8 cells x 8 bins)
+  // Describe each hand turned by its principal axis (CropOptions::normalize_roll) and store
+  // the turn, so that the in-plane roll of a query does not matter and can be recovered
+  // (docs/feature_study.md measures why).
+  bool normalize_roll = true;
   int threads = 0;             // 0: all cores
   int shard_index = 0;         // build only part shard_index of shard_count (contiguous)
   int shard_count = 1;

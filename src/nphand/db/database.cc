@@ -106,6 +106,7 @@ void EncodeEntry(const Entry& e, const RecordLayout& layout, std::span<uint8_t> 
   r[2] = e.meta.with_object ? 1 : 0;
   r[3] = e.meta.has_hand ? 1 : 0;
   std::memcpy(r + 4, &e.meta.viewpoint, 2);
+  std::memcpy(r + 8, &e.meta.roll, 4);
   float* pose = reinterpret_cast<float*>(r + layout.PoseOffset());
   for (int i = 0; i < kPoseVectorSize; ++i) pose[i] = static_cast<float>(e.pose[i]);
   float* angles = reinterpret_cast<float*>(r + layout.AnglesOffset());
@@ -257,7 +258,7 @@ const uint8_t* Database::Record(size_t i) const {
 
 EntryMeta Database::Meta(size_t i) const {
   const uint8_t* r = Record(i);
-  return {r[0], r[1], r[2] != 0, r[3] != 0, Get<uint16_t>(r + 4)};
+  return {r[0], r[1], r[2] != 0, r[3] != 0, Get<uint16_t>(r + 4), Get<float>(r + 8)};
 }
 
 PoseVector Database::Pose(size_t i) const {

@@ -27,10 +27,13 @@ inline constexpr uint32_t kDatabaseVersion = 1;
 inline constexpr int kCropBitsSide = 64;  // the stored hand crop: 64 x 64 bits
 
 // One record, packed: metadata, then the pose, angles, keypoints, HOG and the crop's bits.
+// The crop is the hand as rendered (never turned); the HOG is of the crop turned by
+// EntryMeta::roll when the database normalises roll.
 struct RecordLayout {
   int hog_dimension = 512;
   size_t RecordBytes() const;
-  static constexpr size_t kMetaBytes = 8;  // grasp, step, with_object, has_hand, u16 viewpoint, u16 0
+  // grasp, step, with_object, has_hand (u8 each), u16 viewpoint, u16 0, f32 roll
+  static constexpr size_t kMetaBytes = 12;
   size_t PoseOffset() const { return kMetaBytes; }
   size_t AnglesOffset() const { return PoseOffset() + 4 * kPoseVectorSize; }
   size_t KeypointsOffset() const { return AnglesOffset() + 4 * kNumDofs; }
@@ -46,6 +49,7 @@ struct EntryMeta {
   bool with_object = false;  // rendered with the grasp's object
   bool has_hand = false;     // false when the object hides the whole hand: no features
   uint16_t viewpoint = 0;    // index into the view sphere
+  float roll = 0.0f;         // radians the hand was turned before its HOG (roll normalisation)
 };
 
 // A record's content, for writing.

@@ -40,8 +40,12 @@ double PrincipalRoll(const cv::Mat& mask) {
   // counter-clockwise as displayed; turning by pi/2 + axis makes it vertical.
   const double axis = 0.5 * std::atan2(2.0 * m.mu11, m.mu20 - m.mu02);
   double roll = std::numbers::pi / 2.0 + axis;
-  const cv::Moments turned = cv::moments(RotateMask(mask != 0, roll), true);
-  if (turned.mu03 > 0.0) roll += std::numbers::pi;  // a tail towards the bottom: turn it over
+  // The turned image's "down" is u = (-sin roll, cos roll) in the original one; the third
+  // central moment along u tells which end of the axis has the tail.
+  const double ux = -std::sin(roll), uy = std::cos(roll);
+  const double skew = m.mu30 * ux * ux * ux + 3.0 * m.mu21 * ux * ux * uy + 3.0 * m.mu12 * ux * uy * uy +
+                      m.mu03 * uy * uy * uy;
+  if (skew > 0.0) roll += std::numbers::pi;  // a tail towards the bottom: turn it over
   return std::remainder(roll, 2.0 * std::numbers::pi);
 }
 

@@ -61,8 +61,8 @@ std::vector<float> ComputeHog(const cv::Mat& crop, const HogOptions& options) {
     for (int x = 0; x < side; ++x) {
       const double gx = row[std::min(side - 1, x + 1)] - row[std::max(0, x - 1)];
       const double gy = down[x] - up[x];
+      if (gx == 0.0 && gy == 0.0) continue;  // most of a mask: inside or outside the hand
       const double magnitude = std::hypot(gx, gy);
-      if (magnitude == 0.0) continue;
       double angle = std::atan2(gy, gx);
       angle = std::fmod(angle + 2.0 * range, range);  // [0, range)
       const double position = angle * bins_per_radian;

@@ -1,0 +1,21 @@
+#include "apps/eval_command.h"
+
+#include <iostream>
+
+#include "nphand/render/draw.h"
+#include "nphand/util/io.h"
+
+namespace nphand {
+
+FeatureStudyResult RunEvalFeatures(const EvalFeaturesCommandOptions& options) {
+  const Database db = Database::Open(options.db);
+  const FeatureStudyResult result = RunFeatureStudy(db, options.study, options.quiet ? nullptr : &std::cerr);
+  if (!options.out_dir.empty()) {
+    std::filesystem::create_directories(options.out_dir);
+    WriteFileAtomic(options.out_dir / (options.name + ".json"), ToJson(result).dump(2) + "\n");
+    WriteImageAtomic(options.out_dir / (options.name + ".png"), PlotCurves(result));
+  }
+  return result;
+}
+
+}  // namespace nphand

@@ -1,0 +1,97 @@
+#include "nphand/eval/feature_study.h"
+
+#include <unistd.h>
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "nphand/util/check.h"
+#include "testing/testing.h"
+#include "testing/tiny_db.h"
+
+namespace nphand {
+namespace {
+
+class FeatureStudyTest : public ::testing::Test {
+ protected:
+  static std::filesystem::path Path() {
+    return std::filesystem::temp_directory_path() / ("nphand_feature_study_" + std::to_string(::getpid()) + ".db");
+  }
+  static void SetUpTestSuite() { db_ = new Database(Database::Open(testing::BuildTinyDatabase(Path()))); }
+  static void TearDownTestSuite() {
+    delete db_;
+    db_ = nullptr;
+    std::filesystem::remove(Path());
+  }
+  static FeatureStudyOptions Options() {
+    FeatureStudyOptions options;
+    options.queries = 40;
+    options.neighbours = 10;
+    options.features = {"joints", "hog8x8x8", "dist32"};
+    return options;
+  }
+  static Database* db_;
+};
+Database* FeatureStudyTest::db_ = nullptr;
+
+TEST_F(FeatureStudyTest, CurvesHaveOneValuePerNeighbourAndAreDeterministic) {
+  const FeatureStudyResult a = RunFeatureStudy(*db_, Options(), nullptr);
+  ASSERT_EQ(a.curves.size(), 3u);
+  for (const FeatureCurve& c : a.curves) {
+    ASSERT_EQ(c.joint_deg.size(), 10u);
+    for (int k = 0; k < 10; ++k) {
+      EXPECT_TRUE(std::isfinite(c.joint_deg[k]) && c.joint_deg[k] >= 0.0) << c.name;
+      EXPECT_TRUE(std::isfinite(c.wrist_deg[k]) && c.wrist_deg[k] >= 0.0) << c.name;
+    }
+  }
+  EXPECT_EQ(a.curves[1].dimension, 512);
+  EXPECT_EQ(a.curves[2].dimension, 1024);
+  const FeatureStudyResult b = RunFeatureStudy(*db_, Options(), nullptr);
+  EXPECT_EQ(a.curves[1].joint_deg, b.curves[1].joint_deg);
+}
+
+TEST_F(FeatureStudyTest, QueryAndItsTwinAreLeftOut) {
+  // Every entry has a twin with the same pose (with/without the object): were it not left
+  // out, pose-space neighbour 1 would always be exact.
+  const FeatureStudyResult result = RunFeatureStudy(*db_, Options(), nullptr);
+  EXPECT_GT(result.curves[0].joint_deg[0] + result.curves[0].wrist_deg[0], 0.1);
+}
+
+TEST_F(FeatureStudyTest, PoseSpaceBoundsTheWristErrorOfFeatures) {
+  const FeatureStudyResult result = RunFeatureStudy(*db_, Options(), nullptr);
+  EXPECT_LE(result.curves[0].wrist_deg[0], result.curves[1].wrist_deg[0]);
+}
+
+TEST_F(FeatureStudyTest, RollNormalisationMakesRolledQueriesFindTheirPose) {
+  FeatureStudyOptions options = Options();
+  options.features = {"hog8x8x8"};
+  options.roll_queries = true;
+  const double rolled = RunFeatureStudy(*db_, options, nullptr).curves[0].wrist_deg[0];
+  options.normalize_roll = true;
+  const double normalized = RunFeatureStudy(*db_, options, nullptr).curves[0].wrist_deg[0];
+  // Unnormalised HOG cannot match a turned hand; normalised it recovers the roll.
+  EXPECT_LT(normalized, 0.6 * rolled) << "rolled " << rolled << ", normalised " << normalized;
+}
+
+TEST_F(FeatureStudyTest, OutputsDescribeTheResult) {
+  const FeatureStudyResult result = RunFeatureStudy(*db_, Options(), nullptr);
+  const nlohmann::json json = ToJson(result);
+  EXPECT_EQ(json["curves"].size(), 3u);
+  EXPECT_EQ(json["curves"][1]["paper_joint_deg"][0], 1.32);
+  const std::string table = FormatTable(result);
+  EXPECT_NE(table.find("hog8x8x8"), std::string::npos);
+  EXPECT_NE(table.find("1.32 (2.04, 3.25, 4.19)"), std::string::npos);
+  const cv::Mat plot = PlotCurves(result);
+  EXPECT_EQ(plot.type(), CV_8UC3);
+  EXPECT_GT(cv::countNonZero(plot.reshape(1) != 255), 1000);
+}
+
+TEST_F(FeatureStudyTest, BadOptionsAreRefused) {
+  FeatureStudyOptions options = Options();
+  options.features = {"sift"};
+  EXPECT_THROW(RunFeatureStudy(*db_, options, nullptr), Error);
+}
+
+}  // namespace
+}  // namespace nphand
