@@ -125,6 +125,7 @@ TEST(BuilderTest, InfoCountsWhatTheFileHolds) {
   EXPECT_EQ(info["without_object"], 80);
   EXPECT_EQ(info["features"][0]["dimension"], 512);
   EXPECT_EQ(info["file_bytes"], db.file_bytes());
+  EXPECT_GT(info["view_sphere"]["covering_radius_deg"].get<double>(), 30.0) << "8 directions cover the sphere coarsely";
 }
 
 TEST(BuilderTest, BadOptionsAreRefused) {

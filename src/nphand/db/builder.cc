@@ -288,6 +288,13 @@ nlohmann::json DescribeDatabase(const Database& db) {
       {"crop", header["crop"]},
       {"normalize_roll", header["hog"].value("normalize_roll", false)},
   };
+  const int directions = header.value("viewpoints", 0);
+  if (directions >= 2) {
+    const ViewSphereCoverage coverage = MeasureCoverage(ViewSphereDirections(directions));
+    info["view_sphere"] = {{"directions", directions},
+                           {"max_neighbour_deg", coverage.max_neighbour_deg},
+                           {"covering_radius_deg", coverage.covering_radius_deg}};
+  }
   if (header.contains("shard")) info["shard"] = header["shard"];
   return info;
 }

@@ -58,7 +58,9 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
 // written, byte for byte. Throws nphand::Error if they are not all the shards of one build.
 void MergeDatabases(const std::vector<std::filesystem::path>& shards, const std::filesystem::path& path);
 
-// What a database file holds, for `nphand db info`.
+// What a database file holds, for `nphand db info`: counts, features, sizes, and the view
+// sphere's coverage (the largest angle between neighbouring directions, and from any
+// direction to the nearest sampled one).
 nlohmann::json DescribeDatabase(const Database& db);
 
 }  // namespace nphand
