@@ -55,6 +55,19 @@ HandPose PoseOf(const HandModel& hand, const JointAngles& angles) {
 
 Eigen::Vector3d Midpoint(const JointPositions& p, Joint a, Joint b) { return 0.5 * (p[Index(a)] + p[Index(b)]); }
 
+// The mean tip position of the contact fingers (not the thumb).
+Eigen::Vector3d FingertipCentroid(const GraspDefinition& g, const JointPositions& joints) {
+  Eigen::Vector3d tips = Eigen::Vector3d::Zero();
+  int fingers = 0;
+  for (Digit d : g.contacts) {
+    if (d == Digit::kThumb) continue;
+    tips += joints[Index(kDigitTip[DigitIndex(d)])];
+    ++fingers;
+  }
+  NPHAND_CHECK(fingers > 0, g.name, ": needs a contact finger");
+  return tips / fingers;
+}
+
 Eigen::Vector3d AnchorPoint(const GraspDefinition& g, const JointPositions& p) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int count = 0;
@@ -76,19 +89,10 @@ Eigen::Vector3d AnchorPoint(const GraspDefinition& g, const JointPositions& p) {
       break;
     case Anchor::kProximalPhalanges: fingers(0); break;
     case Anchor::kMiddlePhalanges: fingers(1); break;
-    case Anchor::kPinch: {
-      Eigen::Vector3d tips = Eigen::Vector3d::Zero();
-      int n = 0;
-      for (Digit d : g.contacts) {
-        if (d == Digit::kThumb) continue;
-        tips += p[Index(kDigitTip[DigitIndex(d)])];
-        ++n;
-      }
-      NPHAND_CHECK(n > 0, g.name, ": a pinch needs a finger");
-      sum = 0.5 * (p[Index(Joint::kThumbTip)] + tips / n);
+    case Anchor::kPinch:
+      sum = 0.5 * (p[Index(Joint::kThumbTip)] + FingertipCentroid(g, p));
       count = 1;
       break;
-    }
     case Anchor::kIndexMiddlePhalanx:
       sum = Midpoint(p, Joint::kIndexIntermediate, Joint::kIndexDistal);
       count = 1;
@@ -231,19 +235,6 @@ GraspContact MeasureContact(const HandModel& hand, const JointAngles& angles, co
 }
 
 namespace {
-
-// The mean tip position of the contact fingers (not the thumb).
-Eigen::Vector3d FingertipCentroid(const GraspDefinition& g, const JointPositions& joints) {
-  Eigen::Vector3d tips = Eigen::Vector3d::Zero();
-  int fingers = 0;
-  for (Digit d : g.contacts) {
-    if (d == Digit::kThumb) continue;
-    tips += joints[Index(kDigitTip[DigitIndex(d)])];
-    ++fingers;
-  }
-  NPHAND_CHECK(fingers > 0, g.name, ": needs a contact finger");
-  return tips / fingers;
-}
 
 // Closes each closing motion in turn, from `preshape`, until the skin it moves reaches the
 // object (or the motion ends).
