@@ -98,6 +98,7 @@ TEST(BuilderTest, PartialFileOfOtherOptionsIsStartedAfresh) {
 TEST(BuilderTest, RollNormalisedHogIsTheHogOfTheTurnedCrop) {
   const Database db = Database::Open(testing::BuildTinyDatabase(testing::ScratchDir() / "tiny.db"));
   EXPECT_TRUE(db.header()["hog"]["normalize_roll"].get<bool>());
+  EXPECT_EQ(db.header()["grasp_objects"][1]["object"], "sphere");  // grasp 13, Precision Sphere
   int turned = 0, checked = 0, same_sign = 0;
   for (size_t i = 0; i < db.size(); i += 7) {
     if (!db.Meta(i).has_hand) continue;

@@ -28,7 +28,7 @@ class FeatureStudyTest : public ::testing::Test {
     FeatureStudyOptions options;
     options.queries = 40;
     options.neighbours = 10;
-    options.features = {"joints", "hog8x8x8", "dist32"};
+    options.features = {"joints", "hog8x8x8", "dist32", "chamfer_rerank"};
     return options;
   }
   static Database* db_;
@@ -37,7 +37,7 @@ Database* FeatureStudyTest::db_ = nullptr;
 
 TEST_F(FeatureStudyTest, CurvesHaveOneValuePerNeighbourAndAreDeterministic) {
   const FeatureStudyResult a = RunFeatureStudy(*db_, Options(), nullptr);
-  ASSERT_EQ(a.curves.size(), 3u);
+  ASSERT_EQ(a.curves.size(), 4u);
   for (const FeatureCurve& c : a.curves) {
     ASSERT_EQ(c.joint_deg.size(), 10u);
     for (int k = 0; k < 10; ++k) {
@@ -77,7 +77,7 @@ TEST_F(FeatureStudyTest, RollNormalisationMakesRolledQueriesFindTheirPose) {
 TEST_F(FeatureStudyTest, OutputsDescribeTheResult) {
   const FeatureStudyResult result = RunFeatureStudy(*db_, Options(), nullptr);
   const nlohmann::json json = ToJson(result);
-  EXPECT_EQ(json["curves"].size(), 3u);
+  EXPECT_EQ(json["curves"].size(), 4u);
   EXPECT_EQ(json["curves"][1]["paper_joint_deg"][0], 1.32);
   const std::string table = FormatTable(result);
   EXPECT_NE(table.find("hog8x8x8"), std::string::npos);

@@ -135,8 +135,15 @@ nlohmann::json DatabaseBuildOptions::Header() const {
   RecordLayout layout;
   layout.hog_dimension = hog.Dimension();
   const auto [begin, end] = ShardRange(*this);
+  nlohmann::json objects = nlohmann::json::array();
+  for (int id : GraspsOf(*this)) {
+    const GraspDefinition& g = GraspTaxonomy()[id - 1];
+    const std::vector<double> size(g.object.size.begin(), g.object.size.begin() + ObjectSizeCount(g.object.shape));
+    objects.push_back({{"grasp", id}, {"name", GraspKey(g)}, {"object", ToString(g.object.shape)}, {"size_m", size}});
+  }
   nlohmann::json header = {
       {"format", "nphand database"},
+      {"grasp_objects", objects},
       {"entries", end - begin},
       {"total_entries", TotalEntries()},
       {"record_bytes", layout.RecordBytes()},

@@ -21,6 +21,7 @@ namespace nphand {
 namespace {
 
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+constexpr int kRerank = 200;  // HOG candidates that chamfer re-ranks
 
 // The paper's Fig. 4 table: average joint error (degrees) at neighbours 1, 2, 5, 10.
 const std::map<std::string, std::vector<double>>& PaperFigures() {
@@ -29,7 +30,7 @@ const std::map<std::string, std::vector<double>>& PaperFigures() {
       {"hog8x8x8_pyr", {1.29, 1.99, 3.20, 4.14}}, {"hog8x8x4", {7.59, 8.27, 9.07, 9.99}},
       {"hog8x8x8_nh", {3.57, 5.05, 7.03, 8.27}},  {"hog8x8x16", {1.42}},
       {"hog4x4x8", {1.57}},                       {"hog16x16x8", {1.39}},
-      {"dist32", {1.64}},
+      {"dist32", {1.64}},                         {"chamfer_rerank", {2.07}},
   };
   return kFigures;
 }
@@ -59,7 +60,25 @@ StudyCrop Recrop(const cv::Mat& mask, bool normalize_roll) {
 }
 
 std::vector<float> Describe(const StudyFeature& feature, const cv::Mat& crop) {
-  return feature.kind == StudyFeature::Kind::kHog ? ComputeHog(crop, feature.hog) : DistanceTransformFeature(crop, 32);
+  return feature.kind == StudyFeature::Kind::kDistance ? DistanceTransformFeature(crop, 32) : ComputeHog(crop, feature.hog);
+}
+
+// Reorders each query's row of `labels` (`fetch` wide) by symmetric chamfer distance.
+void RerankByChamfer(const std::vector<StudyCrop>& crops, const std::vector<StudyCrop>& query_crops, int fetch,
+                     std::vector<faiss::Index::idx_t>* labels) {
+  ParallelFor(query_crops.size(), [&](size_t q) {
+    const cv::Mat query_edges = EdgeMap(query_crops[q].image);
+    const cv::Mat query_distance = ContourDistance(query_edges);
+    std::vector<std::pair<double, faiss::Index::idx_t>> scored;
+    for (int r = 0; r < fetch; ++r) {
+      const faiss::Index::idx_t c = (*labels)[q * fetch + r];
+      const cv::Mat edges = EdgeMap(crops[c].image);
+      const double d = 0.5 * (ChamferDistance(query_edges, ContourDistance(edges)) + ChamferDistance(edges, query_distance));
+      scored.emplace_back(d, c);
+    }
+    std::stable_sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (int r = 0; r < fetch; ++r) (*labels)[q * fetch + r] = scored[r].second;
+  });
 }
 
 double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
@@ -87,7 +106,8 @@ std::vector<StudyFeature> PaperFeatures() {
           hog(16, 8),
           hog(8, 8, true),
           hog(8, 8, false, HogNormalization::kCellSum),
-          {"dist32", K::kDistance, {}}};
+          {"dist32", K::kDistance, {}},
+          {"chamfer_rerank", K::kChamferRerank, {}}};
 }
 
 bool FeatureStudyOptions::Check(std::string* why) const {
@@ -187,10 +207,12 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
     // Exact search; a few spare neighbours make room for the query and its twin.
     faiss::IndexFlatL2 index(dimension);
     index.add(static_cast<faiss::Index::idx_t>(candidates.size()), base.data());
-    const int fetch = k + 4;
+    const bool rerank = feature.kind == StudyFeature::Kind::kChamferRerank;
+    const int fetch = static_cast<int>(std::min<size_t>(rerank ? std::max(kRerank, k + 4) : k + 4, candidates.size()));
     std::vector<float> distances(query_count * fetch);
     std::vector<faiss::Index::idx_t> labels(query_count * fetch);
     index.search(static_cast<faiss::Index::idx_t>(query_count), probe.data(), fetch, distances.data(), labels.data());
+    if (rerank) RerankByChamfer(crops, query_crops, fetch, &labels);
 
     FeatureCurve curve;
     curve.name = feature.name;

@@ -20,14 +20,16 @@
 namespace nphand {
 
 // A feature of the study: "joints" (neighbours in pose space: the lower bound), a HOG
-// variant, or "dist32" (the contour distance transform on 32 x 32).
+// variant, "dist32" (the contour distance transform on 32 x 32), or "chamfer_rerank": the
+// symmetric chamfer distance between contours, applied to the 200 nearest by HOG 8x8x8
+// (an exhaustive chamfer search over the database is out of proportion).
 struct StudyFeature {
   std::string name;
-  enum class Kind { kJoints, kHog, kDistance } kind = Kind::kHog;
+  enum class Kind { kJoints, kHog, kDistance, kChamferRerank } kind = Kind::kHog;
   HogOptions hog;
 };
 // The paper's candidates: joints, hog8x8x8, hog8x8x4, hog8x8x16, hog4x4x8, hog16x16x8,
-// hog8x8x8_pyr, hog8x8x8_nh, dist32.
+// hog8x8x8_pyr, hog8x8x8_nh, dist32, chamfer_rerank.
 std::vector<StudyFeature> PaperFeatures();
 
 struct FeatureStudyOptions {
