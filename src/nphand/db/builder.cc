@@ -196,6 +196,7 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
   const size_t record_bytes = c.layout.RecordBytes();
   std::vector<uint8_t> batch(kBatch * record_bytes);
   std::vector<uint64_t> no_hand(threads, 0);
+  double last_report = -1.0;  // progress at most once a second
   for (uint64_t first = begin + summary.resumed; first < end; first += kBatch) {
     const uint64_t count = std::min<uint64_t>(kBatch, end - first);
     std::vector<std::thread> workers;
@@ -211,8 +212,9 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
     }
     for (std::thread& worker : workers) worker.join();
     writer->Append(std::span<const uint8_t>(batch.data(), count * record_bytes));
-    if (progress != nullptr) {
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (progress != nullptr && (seconds >= last_report + 1.0 || first + count == end)) {
+      last_report = seconds;
       const uint64_t done = writer->records_written(), made = done - summary.resumed;
       const double rate = made / std::max(seconds, 1e-9);
       *progress << "\rdb build: " << done << "/" << (end - begin) << " entries ("
