@@ -48,15 +48,25 @@ void ParallelFor(size_t n, Body body) {
   for (std::thread& w : workers) w.join();
 }
 
+// A crop kept as 8-bit coverage (a quarter of the float's memory: 0.9 GB for the default
+// database), turned back into CV_32FC1 coverage where a feature needs it.
 struct StudyCrop {
-  cv::Mat image;  // CV_32FC1 64 x 64 coverage
+  cv::Mat coverage;  // CV_8UC1 64 x 64, 255 = hand
   double roll = 0.0;
+  cv::Mat image() const {
+    cv::Mat image;
+    coverage.convertTo(image, CV_32FC1, 1.0 / 255.0);
+    return image;
+  }
 };
 
 StudyCrop Recrop(const cv::Mat& mask, bool normalize_roll) {
   const std::optional<HandCrop> crop = CropHand(mask, {kCropBitsSide, 0.1, normalize_roll});
   NPHAND_CHECK(crop.has_value(), "a database entry with a hand has an empty crop");
-  return {crop->image, crop->roll};
+  StudyCrop study;
+  crop->image.convertTo(study.coverage, CV_8UC1, 255.0);
+  study.roll = crop->roll;
+  return study;
 }
 
 std::vector<float> Describe(const StudyFeature& feature, const cv::Mat& crop) {
@@ -67,12 +77,12 @@ std::vector<float> Describe(const StudyFeature& feature, const cv::Mat& crop) {
 void RerankByChamfer(const std::vector<StudyCrop>& crops, const std::vector<StudyCrop>& query_crops, int fetch,
                      std::vector<faiss::Index::idx_t>* labels) {
   ParallelFor(query_crops.size(), [&](size_t q) {
-    const cv::Mat query_edges = EdgeMap(query_crops[q].image);
+    const cv::Mat query_edges = EdgeMap(query_crops[q].image());
     const cv::Mat query_distance = ContourDistance(query_edges);
     std::vector<std::pair<double, faiss::Index::idx_t>> scored;
     for (int r = 0; r < fetch; ++r) {
       const faiss::Index::idx_t c = (*labels)[q * fetch + r];
-      const cv::Mat edges = EdgeMap(crops[c].image);
+      const cv::Mat edges = EdgeMap(crops[c].image());
       const double d = 0.5 * (ChamferDistance(query_edges, ContourDistance(edges)) + ChamferDistance(edges, query_distance));
       scored.emplace_back(d, c);
     }
@@ -191,15 +201,15 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
         for (int d = 0; d < dimension; ++d) probe[q * dimension + d] = static_cast<float>(pose[d]);
       }
     } else {
-      dimension = static_cast<int>(Describe(feature, crops[0].image).size());
+      dimension = static_cast<int>(Describe(feature, crops[0].image()).size());
       base.resize(candidates.size() * dimension);
       probe.resize(query_count * dimension);
       ParallelFor(candidates.size(), [&](size_t c) {
-        const std::vector<float> v = Describe(feature, crops[c].image);
+        const std::vector<float> v = Describe(feature, crops[c].image());
         std::copy(v.begin(), v.end(), base.begin() + c * dimension);
       });
       ParallelFor(query_count, [&](size_t q) {
-        const std::vector<float> v = Describe(feature, query_crops[q].image);
+        const std::vector<float> v = Describe(feature, query_crops[q].image());
         std::copy(v.begin(), v.end(), probe.begin() + q * dimension);
       });
     }
