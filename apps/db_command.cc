@@ -1,31 +1,43 @@
 #include "apps/db_command.h"
 
+#include <charconv>
 #include <chrono>
+#include <tuple>
 #include <iostream>
 
 #include "nphand/util/check.h"
+#include "nphand/util/file.h"
 
 namespace nphand {
 
+namespace {
+
+// "i/N" with two whole numbers and nothing else.
+std::pair<int, int> ParseShard(const std::string& text) {
+  const size_t slash = text.find('/');
+  int index = -1, count = -1;
+  const char* end = text.data() + text.size();
+  const bool ok = slash != std::string::npos &&
+                  std::from_chars(text.data(), text.data() + slash, index) ==
+                      std::from_chars_result{text.data() + slash, std::errc()} &&
+                  std::from_chars(text.data() + slash + 1, end, count) == std::from_chars_result{end, std::errc()};
+  NPHAND_THROW_CHECK(ok, "--shard '", text, "': expected i/N, e.g. 0/4");
+  return {index, count};
+}
+
+}  // namespace
+
 nlohmann::json RunDbBuild(DbBuildCommandOptions options) {
   if (!options.shard.empty()) {
-    const size_t slash = options.shard.find('/');
-    try {
-      NPHAND_THROW_CHECK(slash != std::string::npos, "bad");
-      options.build.shard_index = std::stoi(options.shard.substr(0, slash));
-      options.build.shard_count = std::stoi(options.shard.substr(slash + 1));
-    } catch (const std::exception&) {
-      NPHAND_THROW("--shard '", options.shard, "': expected i/N, e.g. 0/4");
-    }
+    std::tie(options.build.shard_index, options.build.shard_count) = ParseShard(options.shard);
   }
-  if (options.out.has_parent_path()) std::filesystem::create_directories(options.out.parent_path());
+  std::string why;
+  NPHAND_THROW_CHECK(options.build.Check(&why), "db build: ", why);
+  CheckOutputFile(options.out, "db build --out");
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
   const BuildSummary summary = BuildDatabase(hand, options.build, options.out, options.quiet ? nullptr : &std::cerr);
-  return {{"path", options.out.string()},
-          {"entries", summary.entries},
-          {"resumed", summary.resumed},
-          {"no_hand", summary.no_hand},
-          {"seconds", summary.seconds}};
+  return {{"path", options.out.string()},     {"entries", summary.entries},         {"resumed", summary.resumed},
+          {"no_hand", summary.no_hand},       {"seconds", summary.seconds},         {"resume_note", summary.resume_note}};
 }
 
 nlohmann::json RunDbMerge(const std::vector<std::filesystem::path>& shards, const std::filesystem::path& out) {

@@ -8,6 +8,7 @@
 #include "nphand/scene/grasp.h"
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
+#include "testing/db_files.h"
 #include "testing/testing.h"
 #include "testing/tiny_db.h"
 
@@ -66,33 +67,121 @@ TEST(BuilderTest, ShardsMergeIntoTheUnshardedFileByteForByte) {
   EXPECT_THROW(MergeDatabases({dir / "whole.db"}, dir / "again.db"), Error);
 }
 
+// An interrupted build: the first `records` of `whole` written in blocks of 25, as the
+// writer leaves them when the process dies, then `tail` bytes of a torn record.
+void Interrupt(const Database& whole, const std::filesystem::path& path, size_t records, size_t tail) {
+  {
+    DatabaseWriter writer(path, TinyDatabaseOptions().Header(), DatabaseWriter::Mode::kFresh);
+    for (size_t begin = 0; begin < records; begin += 25) writer.Append(whole.Records(begin, std::min(records, begin + 25)));
+  }
+  std::vector<uint8_t> partial = ReadFileBytes(path.string() + ".partial");
+  partial.resize(partial.size() + tail, 7);
+  WriteFileAtomic(path.string() + ".partial", partial);
+}
+
 TEST(BuilderTest, InterruptedBuildResumesToTheSameBytes) {
   const auto dir = testing::ScratchDir();
   const std::vector<uint8_t> whole = ReadFileBytes(testing::BuildTinyDatabase(dir / "whole.db"));
-  // An interrupted build: the prologue, 50 whole records and a torn one.
-  const Database db = Database::Open(dir / "whole.db");
-  const size_t start = whole.size() - 20 - db.size() * db.layout().RecordBytes();  // 20: the footer
-  const size_t cut = start + 50 * db.layout().RecordBytes() + 100;
-  WriteFileAtomic(dir / "resumed.db.partial", std::span<const uint8_t>(whole.data(), cut));
+  Interrupt(Database::Open(dir / "whole.db"), dir / "resumed.db", 50, 100);
   const BuildSummary summary = BuildDatabase(RightHand(), TinyDatabaseOptions(), dir / "resumed.db", nullptr);
   EXPECT_EQ(summary.resumed, 50u);
+  EXPECT_EQ(summary.resume_note, "") << "a torn last record is the normal end of an interrupted build";
   EXPECT_EQ(summary.entries, 160u);
   EXPECT_EQ(ReadFileBytes(dir / "resumed.db"), whole);
   EXPECT_FALSE(std::filesystem::exists(dir / "resumed.db.partial"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "resumed.db.partial.blocks"));
 }
 
-TEST(BuilderTest, PartialFileOfOtherOptionsIsStartedAfresh) {
+// A byte flipped in a finished record of the partial file used to reach the final file
+// under a fresh, valid checksum.
+TEST(BuilderTest, ResumeRebuildsFromTheFirstBlockThatFailsItsChecksum) {
+  const auto dir = testing::ScratchDir();
+  const std::vector<uint8_t> whole = ReadFileBytes(testing::BuildTinyDatabase(dir / "whole.db"));
+  const Database db = Database::Open(dir / "whole.db");
+  Interrupt(db, dir / "resumed.db", 100, 0);
+  std::vector<uint8_t> partial = ReadFileBytes(dir / "resumed.db.partial");
+  partial[testing::RecordsOffset(partial) + 60 * db.layout().RecordBytes() + 1000] ^= 0x10;  // record 60
+  WriteFileAtomic(dir / "resumed.db.partial", partial);
+  const BuildSummary summary = BuildDatabase(RightHand(), TinyDatabaseOptions(), dir / "resumed.db", nullptr);
+  EXPECT_EQ(summary.resumed, 50u) << "records 50 to 74 form the block that fails";
+  EXPECT_NE(summary.resume_note.find("records 50 to 74 fail their checksum"), std::string::npos)
+      << summary.resume_note;
+  EXPECT_EQ(ReadFileBytes(dir / "resumed.db"), whole);
+}
+
+// A partial file with more records than the build makes used to give a file that db info
+// then refused.
+TEST(BuilderTest, ResumeDropsRecordsBeyondTheBuild) {
+  const auto dir = testing::ScratchDir();
+  const std::vector<uint8_t> whole = ReadFileBytes(testing::BuildTinyDatabase(dir / "whole.db"));
+  const Database db = Database::Open(dir / "whole.db");
+  Interrupt(db, dir / "resumed.db", 160, 0);
+  std::vector<uint8_t> partial = ReadFileBytes(dir / "resumed.db.partial");
+  const std::span<const uint8_t> extra = db.Records(0, 3);
+  partial.insert(partial.end(), extra.begin(), extra.end());
+  WriteFileAtomic(dir / "resumed.db.partial", partial);
+  const BuildSummary summary = BuildDatabase(RightHand(), TinyDatabaseOptions(), dir / "resumed.db", nullptr);
+  EXPECT_EQ(summary.resumed, 160u);
+  EXPECT_NE(summary.resume_note.find("more records than this build makes"), std::string::npos) << summary.resume_note;
+  EXPECT_EQ(ReadFileBytes(dir / "resumed.db"), whole);
+}
+
+TEST(BuilderTest, PartialFileWithoutBlockChecksumsIsStartedAfresh) {
+  const auto dir = testing::ScratchDir();
+  const std::vector<uint8_t> whole = ReadFileBytes(testing::BuildTinyDatabase(dir / "whole.db"));
+  Interrupt(Database::Open(dir / "whole.db"), dir / "resumed.db", 50, 0);
+  std::filesystem::remove(dir / "resumed.db.partial.blocks");
+  const BuildSummary summary = BuildDatabase(RightHand(), TinyDatabaseOptions(), dir / "resumed.db", nullptr);
+  EXPECT_EQ(summary.resumed, 0u);
+  EXPECT_NE(summary.resume_note.find("cannot be verified"), std::string::npos) << summary.resume_note;
+  EXPECT_EQ(ReadFileBytes(dir / "resumed.db"), whole);
+}
+
+TEST(BuilderTest, PartialFileOfOtherOptionsIsStartedAfreshAndSaidSo) {
   const auto dir = testing::ScratchDir();
   DatabaseBuildOptions other = TinyDatabaseOptions();
-  other.directions = 6;
-  const std::vector<uint8_t> other_bytes = ReadFileBytes([&] {
-    BuildDatabase(RightHand(), other, dir / "other.db", nullptr);
-    return dir / "other.db";
-  }());
-  WriteFileAtomic(dir / "tiny.db.partial", std::span<const uint8_t>(other_bytes.data(), other_bytes.size() / 2));
+  other.normalize_roll = false;
+  {
+    DatabaseWriter writer(dir / "tiny.db", other.Header(), DatabaseWriter::Mode::kFresh);
+  }
   const BuildSummary summary = BuildDatabase(RightHand(), TinyDatabaseOptions(), dir / "tiny.db", nullptr);
   EXPECT_EQ(summary.resumed, 0u);
+  EXPECT_NE(summary.resume_note.find("other options"), std::string::npos) << summary.resume_note;
   EXPECT_EQ(Database::Open(dir / "tiny.db").size(), 160u);
+}
+
+// Two builds into one --out used to corrupt the result while one of them reported success.
+TEST(BuilderTest, SecondBuildIntoTheSamePathIsRefusedWhileTheFirstRuns) {
+  const auto dir = testing::ScratchDir();
+  DatabaseBuildOptions raw = TinyDatabaseOptions();
+  raw.normalize_roll = false;
+  DatabaseWriter running(dir / "x.db", raw.Header(), DatabaseWriter::Mode::kResume);
+  try {
+    BuildDatabase(RightHand(), TinyDatabaseOptions(), dir / "x.db", nullptr);
+    ADD_FAILURE() << "two builds wrote one file";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("another nphand process is writing it"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.db"));
+}
+
+// Destinations used to be checked only at the final rename, after all the work.
+TEST(BuilderTest, BadDestinationsAreRefusedBeforeAnyWork) {
+  const auto dir = testing::ScratchDir();
+  std::filesystem::create_directories(dir / "folder");
+  for (const std::filesystem::path& out : {dir / "folder", std::filesystem::path(), dir / "folder" / "",
+                                           dir / "folder" / ".."}) {
+    EXPECT_THROW(BuildDatabase(RightHand(), TinyDatabaseOptions(), out, nullptr), Error) << out;
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir / "folder")) << "no partial file is left";
+  DatabaseBuildOptions options = TinyDatabaseOptions();
+  options.shard_count = 2;
+  BuildDatabase(RightHand(), options, dir / "a.db", nullptr);
+  options.shard_index = 1;
+  BuildDatabase(RightHand(), options, dir / "b.db", nullptr);
+  EXPECT_THROW(MergeDatabases({dir / "a.db", dir / "b.db"}, dir / "folder"), Error);
+  EXPECT_TRUE(std::filesystem::is_empty(dir / "folder"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "folder.partial"));
 }
 
 TEST(BuilderTest, RollNormalisedHogIsTheHogOfTheTurnedCrop) {

@@ -1,30 +1,51 @@
 #include "nphand/db/database.h"
 
+#include <sys/stat.h>
+
+#include <cstring>
+#include <functional>
+#include <limits>
+
 #include <gtest/gtest.h>
 
+#include "nphand/db/builder.h"
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
+#include "testing/db_files.h"
 #include "testing/testing.h"
 #include "testing/tiny_db.h"
 
 namespace nphand {
 namespace {
 
-// A database of `n` synthetic records with recognisable values.
-std::filesystem::path WriteSynthetic(const std::filesystem::path& path, int n) {
+// The header of a one-grasp database of `directions` viewpoints (10 x directions entries),
+// or of the first of `shards` shards of it.
+nlohmann::json SyntheticHeader(int directions, int shards) {
+  DatabaseBuildOptions options;
+  options.grasps = {1};
+  options.directions = directions;
+  options.hog.cells = 2;
+  options.hog.bins = 4;  // 16 values
+  options.shard_count = shards;
+  return options.Header();
+}
+
+// A database of synthetic records with recognisable values, each at its enumeration place.
+std::filesystem::path WriteSynthetic(const std::filesystem::path& path, int directions, int shards = 1) {
+  const nlohmann::json header = SyntheticHeader(directions, shards);
   RecordLayout layout;
   layout.hog_dimension = 16;
-  const nlohmann::json header = {{"entries", n}, {"record_bytes", layout.RecordBytes()}, {"hog", {{"dimension", 16}}}};
-  DatabaseWriter writer(path, header);
+  DatabaseWriter writer(path, header, DatabaseWriter::Mode::kFresh);
   std::vector<uint8_t> record(layout.RecordBytes());
+  const int n = header["entries"].get<int>();
   for (int i = 0; i < n; ++i) {
     Entry e;
-    e.meta = {static_cast<uint8_t>(i % 33 + 1), static_cast<uint8_t>(i % 5), i % 2 == 1, true, static_cast<uint16_t>(i),
-              0.25f * i};
+    e.meta = {1, static_cast<uint8_t>(i / directions / 2), (i / directions) % 2 == 1, true,
+              static_cast<uint16_t>(i % directions), 0.05f * i};
     for (int k = 0; k < kPoseVectorSize; ++k) e.pose[k] = 0.01 * (i + k);
     for (int k = 0; k < kNumDofs; ++k) e.angles[k] = -0.02 * (i + k);
-    for (int k = 0; k < kNumKeypoints; ++k) e.keypoints[k] = Eigen::Vector3d(i, k, 0.5);
-    e.hog.assign(16, static_cast<float>(i));
+    for (int k = 0; k < kNumKeypoints; ++k) e.keypoints[k] = Eigen::Vector3d(0.01 * i, 0.01 * k, 0.5);
+    e.hog.assign(16, 0.01f * i);
     e.crop = cv::Mat::zeros(kCropBitsSide, kCropBitsSide, CV_8UC1);
     e.crop.at<uint8_t>(i % kCropBitsSide, (3 * i) % kCropBitsSide) = 255;
     EncodeEntry(e, layout, record);
@@ -45,21 +66,22 @@ void ExpectRefused(const std::filesystem::path& path, const std::string& needle)
 }
 
 TEST(DatabaseTest, RecordsRoundTrip) {
-  const auto path = WriteSynthetic(testing::ScratchDir() / "s.db", 7);
+  const auto path = WriteSynthetic(testing::ScratchDir() / "s.db", 3);
   EXPECT_FALSE(std::filesystem::exists(path.string() + ".partial"));
+  EXPECT_FALSE(std::filesystem::exists(path.string() + ".partial.blocks"));
   const Database db = Database::Open(path);
-  ASSERT_EQ(db.size(), 7u);
-  for (int i = 0; i < 7; ++i) {
+  ASSERT_EQ(db.size(), 30u);
+  for (int i = 0; i < 30; ++i) {
     const EntryMeta meta = db.Meta(i);
-    EXPECT_EQ(meta.grasp, i % 33 + 1);
-    EXPECT_EQ(meta.step, i % 5);
-    EXPECT_EQ(meta.with_object, i % 2 == 1);
-    EXPECT_EQ(meta.viewpoint, i);
-    EXPECT_EQ(meta.roll, 0.25f * i);
+    EXPECT_EQ(meta.grasp, 1);
+    EXPECT_EQ(meta.step, i / 6);
+    EXPECT_EQ(meta.with_object, (i / 3) % 2 == 1);
+    EXPECT_EQ(meta.viewpoint, i % 3);
+    EXPECT_EQ(meta.roll, 0.05f * i);
     EXPECT_FLOAT_EQ(static_cast<float>(db.Pose(i)[3]), 0.01f * (i + 3));
     EXPECT_FLOAT_EQ(static_cast<float>(db.Angles(i)[20]), -0.02f * (i + 20));
-    EXPECT_EQ(db.Keypoints(i)[4], Eigen::Vector3d(i, 4, 0.5));
-    EXPECT_EQ(db.Hog(i)[15], static_cast<float>(i));
+    EXPECT_NEAR((db.Keypoints(i)[4] - Eigen::Vector3d(0.01 * i, 0.04, 0.5)).norm(), 0.0, 1e-6);
+    EXPECT_EQ(db.Hog(i)[15], 0.01f * i);
     const cv::Mat crop = db.Crop(i);
     EXPECT_EQ(cv::countNonZero(crop), 1);
     EXPECT_EQ(crop.at<uint8_t>(i % kCropBitsSide, (3 * i) % kCropBitsSide), 255);
@@ -68,7 +90,7 @@ TEST(DatabaseTest, RecordsRoundTrip) {
 
 TEST(DatabaseTest, EveryFlippedByteIsRefused) {
   const auto dir = testing::ScratchDir();
-  const std::vector<uint8_t> good = ReadFileBytes(WriteSynthetic(dir / "good.db", 2));
+  const std::vector<uint8_t> good = ReadFileBytes(WriteSynthetic(dir / "good.db", 2, 10));
   const auto path = dir / "bad.db";
   for (size_t i = 0; i < good.size(); ++i) {
     std::vector<uint8_t> bad = good;
@@ -86,7 +108,7 @@ TEST(DatabaseTest, EveryFlippedByteIsRefused) {
 
 TEST(DatabaseTest, TruncatedForeignAndUnfinishedFilesAreRefusedByName) {
   const auto dir = testing::ScratchDir();
-  const std::vector<uint8_t> good = ReadFileBytes(WriteSynthetic(dir / "good.db", 3));
+  const std::vector<uint8_t> good = ReadFileBytes(WriteSynthetic(dir / "good.db", 2, 10));
   for (size_t length : {size_t{0}, size_t{5}, size_t{20}, size_t{100}, good.size() / 2, good.size() - 1}) {
     WriteFileAtomic(dir / "cut.db", std::span<const uint8_t>(good.data(), length));
     ExpectRefused(dir / "cut.db", length == 0 ? "empty" : "");
@@ -98,15 +120,108 @@ TEST(DatabaseTest, TruncatedForeignAndUnfinishedFilesAreRefusedByName) {
   WriteFileAtomic(dir / "future.db", future);
   ExpectRefused(dir / "future.db", "version 9");
   ExpectRefused(dir / "missing.db", "cannot open");
-  // A writer that never finished leaves only its .partial file.
-  {
-    RecordLayout layout;
-    layout.hog_dimension = 16;
-    DatabaseWriter writer(dir / "unfinished.db", {{"entries", 1}, {"record_bytes", layout.RecordBytes()},
-                                                  {"hog", {{"dimension", 16}}}});
-  }
+  // A writer that never finished leaves only its .partial file (and its block checksums).
+  { DatabaseWriter writer(dir / "unfinished.db", SyntheticHeader(2, 10), DatabaseWriter::Mode::kFresh); }
   EXPECT_FALSE(std::filesystem::exists(dir / "unfinished.db"));
   EXPECT_TRUE(std::filesystem::exists(dir / "unfinished.db.partial"));
+}
+
+TEST(DatabaseTest, WhatIsNotARegularFileIsRefusedByNameWithoutWaiting) {
+  const auto dir = testing::ScratchDir();
+  ASSERT_EQ(::mkfifo((dir / "fifo.db").c_str(), 0600), 0);
+  ExpectRefused(dir / "fifo.db", "FIFO");  // opening a FIFO for reading used to wait for a writer
+  std::filesystem::create_directories(dir / "folder.db");
+  ExpectRefused(dir / "folder.db", "folder");
+}
+
+// Every header field the format defines is checked at open, with a message naming it.
+TEST(DatabaseTest, HeaderSchemaIsValidatedAtOpen) {
+  const auto dir = testing::ScratchDir();
+  const std::vector<uint8_t> good = ReadFileBytes(WriteSynthetic(dir / "good.db", 2, 10));
+  const nlohmann::json header = testing::HeaderOf(good);
+  const auto refuse = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& needle) {
+    nlohmann::json bad = header;
+    edit(bad);
+    WriteFileAtomic(dir / "bad.db", testing::WithHeader(good, bad));
+    ExpectRefused(dir / "bad.db", needle);
+  };
+  WriteFileAtomic(dir / "same.db", testing::WithHeader(good, header));
+  EXPECT_NO_THROW(Database::Open(dir / "same.db")) << "the tampering itself keeps a good file good";
+  refuse([](nlohmann::json& h) { h.erase("render"); }, "lacks the field 'render'");
+  refuse([](nlohmann::json& h) { h.erase("crop"); }, "lacks the field 'crop'");
+  refuse([](nlohmann::json& h) { h["hog"].erase("name"); }, "'hog.name'");
+  refuse([](nlohmann::json& h) { h["render"]["fov_deg"] = "wide"; }, "'render.fov_deg' must be a number");
+  refuse([](nlohmann::json& h) { h["render"]["distance_m"] = -1; }, "'render.distance_m'");
+  refuse([](nlohmann::json& h) { h["hog"]["name"] = 7; }, "'hog.name' must be a string");
+  refuse([](nlohmann::json& h) { h["hog"]["dimension"] = 512; }, "'hog.dimension'");
+  refuse([](nlohmann::json& h) { h["hog"]["normalization"] = "l7"; }, "'hog.normalization'");
+  refuse([](nlohmann::json& h) { h["grasps"] = {0}; }, "'grasps[0]'");
+  refuse([](nlohmann::json& h) { h["grasps"] = nlohmann::json::array(); }, "'grasps'");
+  refuse([](nlohmann::json& h) { h["viewpoints"] = 1; }, "'viewpoints'");
+  refuse([](nlohmann::json& h) { h["total_entries"] = 7; }, "'total_entries'");
+  refuse([](nlohmann::json& h) { h["entries"] = 3; }, "'shard'");
+  refuse([](nlohmann::json& h) { h["shard"]["index"] = 10; }, "'shard.index'");
+  refuse([](nlohmann::json& h) { h["hand"] = "left"; }, "'hand'");
+  refuse([](nlohmann::json& h) { h = nlohmann::json::array({1, 2}); }, "not a JSON object");
+}
+
+// Content read from a file is user input: impossible records are refused by number.
+TEST(DatabaseTest, RecordsWithImpossibleContentAreRefusedDespiteAValidChecksum) {
+  const auto dir = testing::ScratchDir();
+  const std::vector<uint8_t> good = ReadFileBytes(WriteSynthetic(dir / "good.db", 2, 10));
+  const size_t records = testing::RecordsOffset(good);
+  RecordLayout layout;
+  layout.hog_dimension = 16;
+  const size_t second = records + layout.RecordBytes();
+  const auto refuse = [&](const std::function<void(std::vector<uint8_t>&)>& edit, const std::string& needle) {
+    std::vector<uint8_t> bad = good;
+    edit(bad);
+    testing::SealRecords(&bad);
+    WriteFileAtomic(dir / "bad.db", bad);
+    ExpectRefused(dir / "bad.db", needle);
+  };
+  refuse([&](std::vector<uint8_t>& f) { f[records] = 255; }, "record 0 says grasp 255");
+  refuse([&](std::vector<uint8_t>& f) { f[records + 1] = 200; }, "record 0 says grasp 1, step 200");
+  refuse([&](std::vector<uint8_t>& f) { f[records + 2] = 7; }, "record 0");
+  refuse([&](std::vector<uint8_t>& f) { std::copy_n(f.begin() + records, layout.RecordBytes(), f.begin() + second); },
+         "record 1 says grasp 1, step 0, object 0, viewpoint 0 where the header's enumeration has grasp 1, step 0, "
+         "object 0, viewpoint 1");
+  refuse([&](std::vector<uint8_t>& f) { std::fill_n(f.begin() + records + layout.CropOffset(), 512, 0); },
+         "record 0 has a hand but an empty crop");
+  refuse([&](std::vector<uint8_t>& f) { f[second + 3] = 0; }, "record 1 has an impossible roll");
+  refuse([&](std::vector<uint8_t>& f) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::memcpy(f.data() + second + layout.HogOffset(), &nan, 4);
+  }, "record 1 has a HOG value");
+  refuse([&](std::vector<uint8_t>& f) {
+    const float big = 1e9f;
+    std::memcpy(f.data() + records + layout.KeypointsOffset(), &big, 4);
+  }, "record 0 has a pose, angle or keypoint");
+}
+
+TEST(DatabaseTest, SecondWriterOfOnePathIsRefusedByName) {
+  const auto dir = testing::ScratchDir();
+  DatabaseWriter first(dir / "x.db", SyntheticHeader(2, 10), DatabaseWriter::Mode::kFresh);
+  try {
+    DatabaseWriter second(dir / "x.db", SyntheticHeader(2, 10), DatabaseWriter::Mode::kResume);
+    ADD_FAILURE() << "two writers of one file";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("x.db.partial: another nphand process is writing it"), std::string::npos)
+        << e.what();
+  }
+  first.Discard();
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.db.partial"));
+  EXPECT_NO_THROW(DatabaseWriter(dir / "x.db", SyntheticHeader(2, 10), DatabaseWriter::Mode::kFresh));
+}
+
+TEST(DatabaseTest, WriterRefusesAWrongRecordCount) {
+  const auto dir = testing::ScratchDir();
+  RecordLayout layout;
+  layout.hog_dimension = 16;
+  DatabaseWriter writer(dir / "x.db", SyntheticHeader(2, 10), DatabaseWriter::Mode::kFresh);  // 2 records
+  const std::vector<uint8_t> three(3 * layout.RecordBytes(), 0);
+  EXPECT_THROW(writer.Append(three), Error);
+  EXPECT_THROW(writer.Finish(), Error);
 }
 
 TEST(DatabaseTest, TinyBuiltDatabaseOpensAndHoldsHandCrops) {

@@ -11,6 +11,7 @@
 #include "nphand/scene/grasp.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/util/check.h"
+#include "nphand/util/file.h"
 
 namespace nphand {
 namespace {
@@ -176,6 +177,7 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "db build: ", why);
   NPHAND_THROW_CHECK(hand.handedness() == Handedness::kRight, "db build: the database is built from the right hand");
+  CheckOutputFile(path, "db build --out");
   const auto start = std::chrono::steady_clock::now();
 
   Context c{hand, options, GraspsOf(options), {}, ViewSphereDirections(options.directions),
@@ -184,12 +186,12 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
   c.layout.hog_dimension = options.hog.Dimension();
   for (int id : c.grasp_ids) c.grasps.push_back(MakeGrasp(hand, GraspTaxonomy()[id - 1]));
 
-  const nlohmann::json header = options.Header();
-  std::unique_ptr<DatabaseWriter> writer = DatabaseWriter::OpenForResume(path, header);
-  if (writer == nullptr) writer = std::make_unique<DatabaseWriter>(path, header);
+  DatabaseWriter writer(path, options.Header(), DatabaseWriter::Mode::kResume);
   const auto [begin, end] = ShardRange(options);
   BuildSummary summary;
-  summary.resumed = writer->records_written();
+  summary.resumed = writer.records_written();
+  summary.resume_note = writer.resume_note();
+  if (progress != nullptr && !summary.resume_note.empty()) *progress << "db build: " << summary.resume_note << "\n";
 
   const int threads = options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   const size_t record_bytes = c.layout.RecordBytes();
@@ -210,11 +212,11 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
       });
     }
     for (std::thread& worker : workers) worker.join();
-    writer->Append(std::span<const uint8_t>(batch.data(), count * record_bytes));
+    writer.Append(std::span<const uint8_t>(batch.data(), count * record_bytes));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (progress != nullptr && (seconds >= last_report + 1.0 || first + count == end)) {
       last_report = seconds;
-      const uint64_t done = writer->records_written(), made = done - summary.resumed;
+      const uint64_t done = writer.records_written(), made = done - summary.resumed;
       const double rate = made / std::max(seconds, 1e-9);
       *progress << "\rdb build: " << done << "/" << (end - begin) << " entries ("
                 << static_cast<int>(100.0 * done / (end - begin)) << "%), " << static_cast<int>(rate)
@@ -222,8 +224,8 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
     }
   }
   if (progress != nullptr) *progress << "\n";
-  summary.entries = writer->records_written();
-  writer->Finish();
+  summary.entries = writer.records_written();
+  writer.Finish();
   for (uint64_t n : no_hand) summary.no_hand += n;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
@@ -231,6 +233,7 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
 
 void MergeDatabases(const std::vector<std::filesystem::path>& shards, const std::filesystem::path& path) {
   NPHAND_THROW_CHECK(!shards.empty(), "db merge: no shards given");
+  CheckOutputFile(path, "db merge --out");
   std::vector<Database> parts;
   for (const auto& shard : shards) {
     parts.push_back(Database::Open(shard));
@@ -261,10 +264,14 @@ void MergeDatabases(const std::vector<std::filesystem::path>& shards, const std:
   NPHAND_THROW_CHECK(next == header["total_entries"].get<uint64_t>(), "db merge: the shards do not cover the build");
   header["entries"] = next;
   // Key order as an unsharded build writes it (nlohmann::json sorts keys, so this matches).
-  std::filesystem::remove(path.string() + ".partial");
-  DatabaseWriter writer(path, header);
-  for (const Database& part : parts) writer.Append(part.Records(0, part.size()));
-  writer.Finish();
+  DatabaseWriter writer(path, header, DatabaseWriter::Mode::kFresh);
+  try {
+    for (const Database& part : parts) writer.Append(part.Records(0, part.size()));
+    writer.Finish();
+  } catch (const Error&) {
+    writer.Discard();
+    throw;
+  }
 }
 
 nlohmann::json DescribeDatabase(const Database& db) {

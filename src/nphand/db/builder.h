@@ -45,11 +45,13 @@ struct BuildSummary {
   uint64_t entries = 0;        // records in the finished file
   uint64_t resumed = 0;        // of which were already in a partial file
   uint64_t no_hand = 0;        // entries whose hand the object hides completely (this run)
+  std::string resume_note;     // why a partial file was not (wholly) continued, if it was not
   double seconds = 0.0;
 };
 
-// Builds the database file at `path` (atomically). Resumes "<path>.partial" left by an
-// interrupted build with the same options. Reports progress (count, rate, ETA) to
+// Builds the database file at `path` (atomically). Checks `path` before any work. Resumes
+// "<path>.partial" left by an interrupted build with the same options, keeping the blocks of
+// records that still match their checksums; refuses to run while another build writes it. Reports progress (count, rate, ETA) to
 // `progress` if not null.
 BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& options,
                            const std::filesystem::path& path, std::ostream* progress);

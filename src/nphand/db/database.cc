@@ -1,14 +1,16 @@
 #include "nphand/db/database.h"
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
+#include <set>
 
-#include <fcntl.h>
 #include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <zlib.h>
 
+#include "nphand/features/hog.h"
+#include "nphand/scene/grasp.h"
 #include "nphand/util/check.h"
 
 namespace nphand {
@@ -55,17 +57,100 @@ std::vector<uint8_t> Prologue(const nlohmann::json& header) {
   return out;
 }
 
-RecordLayout LayoutOf(const nlohmann::json& header, const std::string& source) {
-  RecordLayout layout;
-  try {
-    layout.hog_dimension = header.at("hog").at("dimension").get<int>();
-    NPHAND_THROW_CHECK(header.at("record_bytes").get<size_t>() == layout.RecordBytes(), source,
-                       ": the header's record size does not match its features");
-  } catch (const nlohmann::json::exception& e) {
-    NPHAND_THROW(source, ": the header lacks a field (", e.what(), ")");
+// Reads typed header fields, naming the file and the field's path when one is missing, of
+// the wrong type or out of range.
+class HeaderFields {
+ public:
+  explicit HeaderFields(const std::string& source) : source_(source) {}
+
+  const nlohmann::json& Object(const nlohmann::json& parent, const std::string& key, const std::string& path) const {
+    const nlohmann::json& value = At(parent, key, path);
+    NPHAND_THROW_CHECK(value.is_object(), source_, ": header field '", path, "' must be an object");
+    return value;
   }
-  NPHAND_THROW_CHECK(layout.hog_dimension > 0 && layout.hog_dimension < 100000, source, ": bad HOG dimension");
+  const nlohmann::json& Array(const nlohmann::json& parent, const std::string& key, const std::string& path) const {
+    const nlohmann::json& value = At(parent, key, path);
+    NPHAND_THROW_CHECK(value.is_array(), source_, ": header field '", path, "' must be an array");
+    return value;
+  }
+  int64_t Integer(const nlohmann::json& parent, const std::string& key, const std::string& path, int64_t min,
+                  int64_t max) const {
+    return Integer(At(parent, key, path), path, min, max);
+  }
+  int64_t Integer(const nlohmann::json& value, const std::string& path, int64_t min, int64_t max) const {
+    NPHAND_THROW_CHECK(value.is_number_integer() && value.get<int64_t>() >= min && value.get<int64_t>() <= max, source_,
+                       ": header field '", path, "' must be an integer in [", min, ", ", max, "], not ",
+                       value.dump());
+    return value.get<int64_t>();
+  }
+  double Number(const nlohmann::json& parent, const std::string& key, const std::string& path, double min,
+                double max) const {
+    return Number(At(parent, key, path), path, min, max);
+  }
+  double Number(const nlohmann::json& value, const std::string& path, double min, double max) const {
+    NPHAND_THROW_CHECK(value.is_number() && value.get<double>() >= min && value.get<double>() <= max, source_,
+                       ": header field '", path, "' must be a number in [", min, ", ", max, "], not ", value.dump());
+    return value.get<double>();
+  }
+  bool Boolean(const nlohmann::json& parent, const std::string& key, const std::string& path) const {
+    const nlohmann::json& value = At(parent, key, path);
+    NPHAND_THROW_CHECK(value.is_boolean(), source_, ": header field '", path, "' must be true or false, not ",
+                       value.dump());
+    return value.get<bool>();
+  }
+  std::string String(const nlohmann::json& parent, const std::string& key, const std::string& path) const {
+    const nlohmann::json& value = At(parent, key, path);
+    NPHAND_THROW_CHECK(value.is_string(), source_, ": header field '", path, "' must be a string, not ", value.dump());
+    return value.get<std::string>();
+  }
+  void Expect(bool condition, const std::string& path, const std::string& what) const {
+    NPHAND_THROW_CHECK(condition, source_, ": header field '", path, "' ", what);
+  }
+
+ private:
+  const nlohmann::json& At(const nlohmann::json& parent, const std::string& key, const std::string& path) const {
+    const auto it = parent.find(key);
+    NPHAND_THROW_CHECK(it != parent.end(), source_, ": the header lacks the field '", path, "'");
+    return *it;
+  }
+  const std::string& source_;
+};
+
+RecordLayout LayoutOf(const nlohmann::json& header, const std::string& source) {
+  ValidateHeader(header, source);
+  RecordLayout layout;
+  layout.hog_dimension = header["hog"]["dimension"].get<int>();
   return layout;
+}
+
+// Where the records of a (validated) header sit in the full enumeration.
+struct Enumeration {
+  std::vector<int> grasps;
+  uint64_t steps = 0, viewpoints = 0, begin = 0;
+
+  explicit Enumeration(const nlohmann::json& header)
+      : grasps(header["grasps"].get<std::vector<int>>()),
+        steps(header["steps"].get<uint64_t>()),
+        viewpoints(header["viewpoints"].get<uint64_t>()),
+        begin(header.contains("shard") ? header["shard"]["begin"].get<uint64_t>() : 0) {}
+  // The meta of record `i` of the file (see the header's "order").
+  EntryMeta At(uint64_t i) const {
+    const uint64_t index = begin + i;
+    EntryMeta meta;
+    meta.viewpoint = static_cast<uint16_t>(index % viewpoints);
+    meta.with_object = (index / viewpoints) % 2 == 1;
+    meta.step = static_cast<uint8_t>((index / viewpoints / 2) % steps);
+    meta.grasp = static_cast<uint8_t>(grasps[index / viewpoints / 2 / steps]);
+    return meta;
+  }
+};
+
+bool AllFinite(const uint8_t* p, size_t count, float min, float max) {
+  for (size_t i = 0; i < count; ++i) {
+    const float v = Get<float>(p + 4 * i);
+    if (!(v >= min && v <= max)) return false;  // also false for NaN
+  }
+  return true;
 }
 
 // Parses and checks the prologue at the start of `bytes`; returns the header and where the
@@ -82,7 +167,7 @@ std::pair<nlohmann::json, size_t> ReadPrologue(const uint8_t* bytes, size_t size
   NPHAND_THROW_CHECK(Get<uint32_t>(text + header_bytes) == Crc(0, text, header_bytes), source,
                      ": checksum mismatch in the header");
   nlohmann::json header = nlohmann::json::parse(text, text + header_bytes, nullptr, false);
-  NPHAND_THROW_CHECK(!header.is_discarded() && header.is_object(), source, ": the header is not valid JSON");
+  NPHAND_THROW_CHECK(!header.is_discarded(), source, ": the header is not valid JSON");
   const size_t data = (16 + size_t{header_bytes} + 4 + kAlignment - 1) / kAlignment * kAlignment;
   NPHAND_THROW_CHECK(data <= size, source, ": truncated after the header");
   for (size_t i = 16 + size_t{header_bytes} + 4; i < data; ++i) {
@@ -92,6 +177,83 @@ std::pair<nlohmann::json, size_t> ReadPrologue(const uint8_t* bytes, size_t size
 }
 
 }  // namespace
+
+void ValidateHeader(const nlohmann::json& header, const std::string& source) {
+  const HeaderFields f(source);
+  NPHAND_THROW_CHECK(header.is_object(), source, ": the header is not a JSON object");
+  f.Expect(f.String(header, "format", "format") == "nphand database", "format", "must be \"nphand database\"");
+  f.Expect(f.String(header, "hand", "hand") == "right", "hand", "must be \"right\" (the database holds right hands)");
+  f.Expect(f.String(header, "view_sphere", "view_sphere") == "fibonacci", "view_sphere", "must be \"fibonacci\"");
+  f.String(header, "order", "order");
+  f.String(header, "hand_asset_sha256", "hand_asset_sha256");
+
+  const nlohmann::json& grasps = f.Array(header, "grasps", "grasps");
+  f.Expect(!grasps.empty() && grasps.size() <= kNumGrasps, "grasps", "must list 1 to 33 grasps");
+  std::set<int64_t> seen;
+  for (size_t i = 0; i < grasps.size(); ++i) {
+    seen.insert(f.Integer(grasps[i], "grasps[" + std::to_string(i) + "]", 1, kNumGrasps));
+  }
+  f.Expect(seen.size() == grasps.size(), "grasps", "lists a grasp twice");
+  const nlohmann::json& objects = f.Array(header, "grasp_objects", "grasp_objects");
+  f.Expect(objects.size() == grasps.size(), "grasp_objects", "must have one object per grasp");
+  for (size_t i = 0; i < objects.size(); ++i) {
+    const std::string at = "grasp_objects[" + std::to_string(i) + "]";
+    f.Expect(objects[i].is_object(), at, "must be an object");
+    f.Expect(f.Integer(objects[i], "grasp", at + ".grasp", 1, kNumGrasps) == grasps[i].get<int64_t>(), at + ".grasp",
+             "must follow the order of 'grasps'");
+    f.String(objects[i], "name", at + ".name");
+    f.String(objects[i], "object", at + ".object");
+    const nlohmann::json& size = f.Array(objects[i], "size_m", at + ".size_m");
+    for (size_t k = 0; k < size.size(); ++k) f.Number(size[k], at + ".size_m[" + std::to_string(k) + "]", 0.0, 10.0);
+  }
+
+  const int64_t steps = f.Integer(header, "steps", "steps", 1, 255);
+  const int64_t viewpoints = f.Integer(header, "viewpoints", "viewpoints", 2, 65535);
+  const uint64_t total = static_cast<uint64_t>(grasps.size()) * steps * 2 * viewpoints;
+  f.Expect(f.Integer(header, "total_entries", "total_entries", 0, INT64_MAX) == static_cast<int64_t>(total),
+           "total_entries", "must be grasps x steps x 2 x viewpoints = " + std::to_string(total));
+  const int64_t entries = f.Integer(header, "entries", "entries", 0, static_cast<int64_t>(total));
+  if (header.contains("shard")) {
+    const nlohmann::json& shard = f.Object(header, "shard", "shard");
+    const int64_t count = f.Integer(shard, "count", "shard.count", 2, 1 << 20);
+    f.Integer(shard, "index", "shard.index", 0, count - 1);
+    const int64_t begin = f.Integer(shard, "begin", "shard.begin", 0, static_cast<int64_t>(total));
+    const int64_t end = f.Integer(shard, "end", "shard.end", begin, static_cast<int64_t>(total));
+    f.Expect(end - begin == entries, "shard", "must cover 'entries' records (end - begin)");
+  } else {
+    f.Expect(entries == static_cast<int64_t>(total), "entries", "must equal total_entries in a file that is no shard");
+  }
+
+  const nlohmann::json& render = f.Object(header, "render", "render");
+  f.Integer(render, "image_size", "render.image_size", 16, 8192);
+  f.Number(render, "fov_deg", "render.fov_deg", 5.0, 120.0);
+  f.Number(render, "distance_m", "render.distance_m", 0.1, 10.0);
+  const nlohmann::json& crop = f.Object(header, "crop", "crop");
+  f.Integer(crop, "size", "crop.size", kCropBitsSide, kCropBitsSide);
+  f.Number(crop, "margin", "crop.margin", 0.0, 1.0);
+
+  const nlohmann::json& hog = f.Object(header, "hog", "hog");
+  HogOptions options;
+  options.cells = static_cast<int>(f.Integer(hog, "cells", "hog.cells", 1, kCropBitsSide));
+  options.bins = static_cast<int>(f.Integer(hog, "bins", "hog.bins", 1, 360));
+  options.pyramid = f.Boolean(hog, "pyramid", "hog.pyramid");
+  options.signed_orientation = f.Boolean(hog, "signed", "hog.signed");
+  const std::string normalization = f.String(hog, "normalization", "hog.normalization");
+  f.Expect(normalization == ToString(HogNormalization::kGlobalL2) || normalization == ToString(HogNormalization::kCellSum),
+           "hog.normalization", "is not a HOG normalisation nphand knows");
+  options.normalization = HogNormalizationFromString(normalization);
+  f.Boolean(hog, "normalize_roll", "hog.normalize_roll");
+  std::string why;
+  f.Expect(options.Check(&why), "hog", "describes an impossible HOG (" + why + ")");
+  f.Expect(kCropBitsSide % options.cells == 0, "hog.cells", "must divide the crop side");
+  f.Expect(f.String(hog, "name", "hog.name") == options.Name(), "hog.name", "must be " + options.Name());
+  f.Expect(f.Integer(hog, "dimension", "hog.dimension", 1, 1 << 20) == options.Dimension(), "hog.dimension",
+           "must be " + std::to_string(options.Dimension()) + " for " + options.Name());
+  RecordLayout layout;
+  layout.hog_dimension = options.Dimension();
+  f.Expect(f.Integer(header, "record_bytes", "record_bytes", 1, 1 << 30) == static_cast<int64_t>(layout.RecordBytes()),
+           "record_bytes", "does not match the features (" + std::to_string(layout.RecordBytes()) + " bytes)");
+}
 
 size_t RecordLayout::RecordBytes() const { return CropOffset() + kCropBytes; }
 
@@ -124,85 +286,127 @@ void EncodeEntry(const Entry& e, const RecordLayout& layout, std::span<uint8_t> 
   }
 }
 
-DatabaseWriter::DatabaseWriter(const std::filesystem::path& path, const nlohmann::json& header)
-    : path_(path), partial_(path.string() + ".partial") {
-  record_bytes_ = LayoutOf(header, path.string()).RecordBytes();
-  file_ = std::fopen(partial_.c_str(), "wb");
-  NPHAND_THROW_CHECK(file_ != nullptr, partial_.string(), ": cannot open for writing (", std::strerror(errno), ")");
-  const std::vector<uint8_t> prologue = Prologue(header);
-  NPHAND_THROW_CHECK(std::fwrite(prologue.data(), 1, prologue.size(), file_) == prologue.size(), partial_.string(),
-                     ": write failed");
+namespace {
+
+constexpr char kBlocksMagic[8] = {'N', 'P', 'H', 'B', 'L', 'K', 'S', '1'};
+constexpr size_t kBlockEntryBytes = 8 + 4;  // u64 records, u32 CRC-32 of their bytes
+
+std::filesystem::path PartialOf(const std::filesystem::path& path) { return path.string() + ".partial"; }
+std::filesystem::path BlocksOf(const std::filesystem::path& path) { return path.string() + ".partial.blocks"; }
+
+}  // namespace
+
+DatabaseWriter::DatabaseWriter(const std::filesystem::path& path, const nlohmann::json& header, Mode mode)
+    : path_(path), prologue_(Prologue(header)) {
+  const RecordLayout layout = LayoutOf(header, path.string());
+  record_bytes_ = layout.RecordBytes();
+  expected_ = header["entries"].get<uint64_t>();
+  file_ = File::OpenLocked(PartialOf(path));
+  blocks_ = File::OpenLocked(BlocksOf(path));
+  if (mode == Mode::kResume && file_.Size() > 0) {
+    Resume();
+  } else {
+    StartAfresh();
+  }
 }
 
-std::unique_ptr<DatabaseWriter> DatabaseWriter::OpenForResume(const std::filesystem::path& path,
-                                                              const nlohmann::json& header) {
-  const std::filesystem::path partial = path.string() + ".partial";
-  if (!std::filesystem::exists(partial)) return nullptr;
-  const std::vector<uint8_t> expected = Prologue(header);
-  const uint64_t size = std::filesystem::file_size(partial);
-  std::unique_ptr<DatabaseWriter> writer(new DatabaseWriter());
-  writer->path_ = path;
-  writer->partial_ = partial;
-  writer->record_bytes_ = LayoutOf(header, path.string()).RecordBytes();
-  writer->file_ = std::fopen(partial.c_str(), "r+b");
-  NPHAND_THROW_CHECK(writer->file_ != nullptr, partial.string(), ": cannot open to resume (", std::strerror(errno), ")");
-  // Only a partial file of the same build (the same prologue) is continued.
-  std::vector<uint8_t> prologue(expected.size());
-  if (size < expected.size() || std::fread(prologue.data(), 1, prologue.size(), writer->file_) != prologue.size() ||
-      prologue != expected) {
-    return nullptr;
-  }
-  writer->count_ = (size - expected.size()) / writer->record_bytes_;
-  std::vector<uint8_t> record(writer->record_bytes_);
-  for (uint64_t i = 0; i < writer->count_; ++i) {
-    NPHAND_THROW_CHECK(std::fread(record.data(), 1, record.size(), writer->file_) == record.size(), partial.string(),
-                       ": read failed while resuming");
-    writer->crc_ = Crc(writer->crc_, record.data(), record.size());
-  }
-  const uint64_t keep = expected.size() + writer->count_ * writer->record_bytes_;
-  NPHAND_THROW_CHECK(::ftruncate(fileno(writer->file_), static_cast<off_t>(keep)) == 0, partial.string(),
-                     ": cannot drop a torn record");
-  std::fseek(writer->file_, static_cast<long>(keep), SEEK_SET);
-  return writer;
+void DatabaseWriter::StartAfresh() {
+  file_.Truncate(0);
+  file_.WriteAt(0, prologue_);
+  blocks_.Truncate(0);
+  blocks_.WriteAt(0, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(kBlocksMagic), 8));
+  count_ = 0;
+  crc_ = 0;
 }
 
-DatabaseWriter::~DatabaseWriter() {
-  if (file_ != nullptr) std::fclose(file_);
+void DatabaseWriter::Resume() {
+  const std::string partial = file_.path().string();
+  std::vector<uint8_t> prologue(prologue_.size());
+  if (!file_.ReadAt(0, prologue) || prologue != prologue_) {
+    note_ = partial + ": left by a build with other options (another header); starting over";
+    StartAfresh();
+    return;
+  }
+  std::vector<uint8_t> magic(8);
+  if (!blocks_.ReadAt(0, magic) || std::memcmp(magic.data(), kBlocksMagic, 8) != 0) {
+    note_ = blocks_.path().string() + ": missing or foreign, so the records of " + partial +
+            " cannot be verified; starting over";
+    StartAfresh();
+    return;
+  }
+  // Keep the blocks whose bytes still match their checksums, up to the first that does not.
+  const uint64_t size = file_.Size();
+  uint64_t kept_blocks = 0;
+  std::vector<uint8_t> entry(kBlockEntryBytes), block;
+  while (blocks_.ReadAt(8 + kept_blocks * kBlockEntryBytes, entry)) {
+    const uint64_t records = Get<uint64_t>(entry.data());
+    const uint64_t offset = prologue_.size() + count_ * record_bytes_;
+    if (records == 0 || records > expected_ - count_ || records * record_bytes_ > size - offset) break;
+    block.resize(records * record_bytes_);
+    if (!file_.ReadAt(offset, block) || Crc(0, block.data(), block.size()) != Get<uint32_t>(entry.data() + 8)) {
+      note_ = partial + ": records " + std::to_string(count_) + " to " + std::to_string(count_ + records - 1) +
+              " fail their checksum; building again from record " + std::to_string(count_);
+      break;
+    }
+    crc_ = Crc(crc_, block.data(), block.size());
+    count_ += records;
+    ++kept_blocks;
+  }
+  const uint64_t kept_bytes = prologue_.size() + count_ * record_bytes_;
+  if (note_.empty() && size - kept_bytes >= record_bytes_ && count_ == expected_) {
+    note_ = partial + ": holds more records than this build makes; the extra ones are dropped";
+  }
+  file_.Truncate(kept_bytes);
+  blocks_.Truncate(8 + kept_blocks * kBlockEntryBytes);
 }
 
 void DatabaseWriter::Append(std::span<const uint8_t> records) {
-  NPHAND_CHECK(file_ != nullptr && records.size() % record_bytes_ == 0);
-  NPHAND_THROW_CHECK(std::fwrite(records.data(), 1, records.size(), file_) == records.size() && std::fflush(file_) == 0,
-                     partial_.string(), ": write failed (", std::strerror(errno), ")");
-  crc_ = Crc(crc_, records.data(), records.size());
-  count_ += records.size() / record_bytes_;
+  NPHAND_CHECK(file_.fd() >= 0 && records.size() % record_bytes_ == 0);
+  const uint64_t count = records.size() / record_bytes_;
+  NPHAND_THROW_CHECK(count_ + count <= expected_, file_.path().string(), ": ", count_ + count,
+                     " records would exceed the header's ", expected_);
+  file_.WriteAt(prologue_.size() + count_ * record_bytes_, records);
+  const uint32_t block_crc = Crc(0, records.data(), records.size());
+  std::vector<uint8_t> entry;
+  Put<uint64_t>(&entry, count);
+  Put<uint32_t>(&entry, block_crc);
+  blocks_.Append(entry);
+  crc_ = static_cast<uint32_t>(crc32_combine(crc_, block_crc, static_cast<z_off_t>(records.size())));
+  count_ += count;
 }
 
 void DatabaseWriter::Finish() {
-  NPHAND_CHECK(file_ != nullptr);
+  NPHAND_CHECK(file_.fd() >= 0);
+  NPHAND_THROW_CHECK(count_ == expected_, file_.path().string(), ": holds ", count_, " records, the header says ",
+                     expected_);
   std::vector<uint8_t> footer(kFooterMagic, kFooterMagic + 8);
   Put<uint64_t>(&footer, count_);
   Put<uint32_t>(&footer, crc_);
-  const bool ok = std::fwrite(footer.data(), 1, footer.size(), file_) == footer.size() && std::fflush(file_) == 0 &&
-                  ::fsync(fileno(file_)) == 0;
-  std::fclose(file_);
-  file_ = nullptr;
-  NPHAND_THROW_CHECK(ok, partial_.string(), ": writing the footer failed (", std::strerror(errno), ")");
+  file_.WriteAt(prologue_.size() + count_ * record_bytes_, footer);
+  file_.Sync();
   std::error_code ec;
-  std::filesystem::rename(partial_, path_, ec);
+  std::filesystem::rename(file_.path(), path_, ec);
   NPHAND_THROW_CHECK(!ec, path_.string(), ": cannot rename the finished file into place (", ec.message(), ")");
+  std::filesystem::remove(blocks_.path(), ec);
+  file_.Close();
+  blocks_.Close();
+}
+
+void DatabaseWriter::Discard() {
+  std::error_code ec;
+  std::filesystem::remove(file_.path(), ec);
+  std::filesystem::remove(blocks_.path(), ec);
+  file_.Close();
+  blocks_.Close();
 }
 
 Database Database::Open(const std::filesystem::path& path, bool verify_records) {
   const std::string source = path.string();
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  NPHAND_THROW_CHECK(fd >= 0, source, ": cannot open (", std::strerror(errno), ")");
-  struct stat info {};
-  const bool statted = ::fstat(fd, &info) == 0;
-  const size_t size = statted ? static_cast<size_t>(info.st_size) : 0;
-  void* mapped = size > 0 ? ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0) : MAP_FAILED;
-  ::close(fd);
-  NPHAND_THROW_CHECK(mapped != MAP_FAILED, source, size == 0 ? ": empty file" : ": cannot map the file");
+  const File file = File::OpenRegular(path);
+  const size_t size = file.Size();
+  NPHAND_THROW_CHECK(size > 0, source, ": empty file");
+  void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, file.fd(), 0);
+  NPHAND_THROW_CHECK(mapped != MAP_FAILED, source, ": cannot map the file (", std::strerror(errno), ")");
   Database db;
   db.path_ = path;
   db.mapped_ = static_cast<const uint8_t*>(mapped);
@@ -220,15 +424,46 @@ Database Database::Open(const std::filesystem::path& path, bool verify_records) 
   NPHAND_THROW_CHECK(count == (size - kFooterBytes - data) / record_bytes &&
                          data + count * record_bytes + kFooterBytes == size,
                      source, ": the record count ", count, " does not match the file size ", size);
-  NPHAND_THROW_CHECK(db.header_.value("entries", uint64_t{0}) == count, source, ": the header says ",
-                     db.header_.value("entries", uint64_t{0}), " entries, the file holds ", count);
+  NPHAND_THROW_CHECK(db.header_["entries"].get<uint64_t>() == count, source, ": the header says ",
+                     db.header_["entries"].get<uint64_t>(), " entries, the file holds ", count);
   db.records_ = db.mapped_ + data;
   db.count_ = count;
   if (verify_records) {
     NPHAND_THROW_CHECK(Crc(0, db.records_, count * record_bytes) == Get<uint32_t>(footer + 16), source,
                        ": checksum mismatch in the records");
+    db.VerifyRecords();
   }
   return db;
+}
+
+void Database::VerifyRecords() const {
+  const Enumeration enumeration(header_);
+  const std::string source = path_.string();
+  const RecordLayout& l = layout_;
+  for (size_t i = 0; i < count_; ++i) {
+    const uint8_t* r = records_ + i * l.RecordBytes();
+    const EntryMeta meta = Meta(i), expected = enumeration.At(i);
+    NPHAND_THROW_CHECK(meta.grasp == expected.grasp && meta.step == expected.step &&
+                           meta.with_object == expected.with_object && meta.viewpoint == expected.viewpoint,
+                       source, ": record ", i, " says grasp ", int{meta.grasp}, ", step ", int{meta.step}, ", object ",
+                       meta.with_object, ", viewpoint ", meta.viewpoint, " where the header's enumeration has grasp ",
+                       int{expected.grasp}, ", step ", int{expected.step}, ", object ", expected.with_object,
+                       ", viewpoint ", expected.viewpoint);
+    NPHAND_THROW_CHECK(r[2] <= 1 && r[3] <= 1 && r[6] == 0 && r[7] == 0, source, ": record ", i,
+                       " has impossible flags");
+    NPHAND_THROW_CHECK(std::abs(meta.roll) <= 3.1416f && (meta.has_hand || meta.roll == 0.0f), source, ": record ", i,
+                       " has an impossible roll ", meta.roll);
+    NPHAND_THROW_CHECK(AllFinite(r + l.PoseOffset(), kPoseVectorSize, -1.0001f, 1.0001f) &&
+                           AllFinite(r + l.AnglesOffset(), kNumDofs, -3.1416f, 3.1416f) &&
+                           AllFinite(r + l.KeypointsOffset(), 3 * kNumKeypoints, -10.0f, 10.0f),
+                       source, ": record ", i, " has a pose, angle or keypoint that is not a number or out of range");
+    NPHAND_THROW_CHECK(AllFinite(r + l.HogOffset(), l.hog_dimension, 0.0f, meta.has_hand ? 1.0001f : 0.0f), source,
+                       ": record ", i, " has a HOG value that is not a number or out of range");
+    const uint8_t* bits = r + l.CropOffset();
+    const bool empty = std::all_of(bits, bits + RecordLayout::kCropBytes, [](uint8_t b) { return b == 0; });
+    NPHAND_THROW_CHECK(empty != meta.has_hand, source, ": record ", i,
+                       meta.has_hand ? " has a hand but an empty crop" : " has no hand but a crop");
+  }
 }
 
 Database::~Database() {

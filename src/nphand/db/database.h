@@ -15,11 +15,13 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include "nphand/model/hand_model.h"
+#include "nphand/util/file.h"
 
 namespace nphand {
 
@@ -62,43 +64,63 @@ struct Entry {
   cv::Mat crop;              // CV_8UC1, kCropBitsSide square, non-zero = hand
 };
 
+// Checks a header against the format's schema; throws nphand::Error naming `source` and
+// the field ("x.db: header field 'render.fov_deg' must be a number in [5, 120]").
+void ValidateHeader(const nlohmann::json& header, const std::string& source);
+
 // Serialises entries into the record format.
 void EncodeEntry(const Entry& entry, const RecordLayout& layout, std::span<uint8_t> record);
 
-// Writes a database file atomically: records go to "<path>.partial"; Finish() adds the
-// footer, flushes and renames. An unfinished writer leaves the partial file, from which
-// OpenForResume continues.
+// Writes a database file atomically: records go to "<path>.partial", locked against other
+// writers for the writer's life; Finish() adds the footer, flushes and renames. Each
+// appended block of records has its CRC-32 in "<path>.partial.blocks", so that a resumed
+// build keeps only records that are still what was written.
 class DatabaseWriter {
  public:
-  // Starts a new partial file.
-  DatabaseWriter(const std::filesystem::path& path, const nlohmann::json& header);
-  // Continues "<path>.partial" if it holds the same header; its complete records are kept
-  // (a torn last record is dropped). Returns nullptr when there is nothing to resume.
-  static std::unique_ptr<DatabaseWriter> OpenForResume(const std::filesystem::path& path,
-                                                       const nlohmann::json& header);
-  ~DatabaseWriter();
+  enum class Mode {
+    kFresh,   // start the partial file afresh
+    kResume,  // continue a partial file of the same header: its verified blocks are kept
+  };
+  // Locks "<path>.partial" (throws naming it when another writer holds it) and opens it.
+  // The header must be a valid database header (see Database::Open).
+  DatabaseWriter(const std::filesystem::path& path, const nlohmann::json& header, Mode mode);
   DatabaseWriter(const DatabaseWriter&) = delete;
   DatabaseWriter& operator=(const DatabaseWriter&) = delete;
 
-  // Appends whole records (a multiple of the record size) and flushes them.
+  // Appends whole records (a multiple of the record size) as one block.
   void Append(std::span<const uint8_t> records);
   uint64_t records_written() const { return count_; }
-  // Writes the footer and renames the partial file to the final path.
+  // Why a partial file that was there was not continued, or not all of it (another build's
+  // header, a block that fails its checksum, more records than the header says); empty
+  // when there was none or all of it was kept.
+  const std::string& resume_note() const { return note_; }
+  // Writes the footer, flushes and renames the partial file to the final path. Throws if
+  // the records written are not the header's count.
   void Finish();
+  // Removes the partial file and its block checksums: for a failure a rerun cannot mend.
+  void Discard();
 
  private:
-  DatabaseWriter() = default;
-  std::filesystem::path path_, partial_;
+  void StartAfresh();
+  void Resume();
+
+  std::filesystem::path path_;
+  std::vector<uint8_t> prologue_;
   size_t record_bytes_ = 0;
+  uint64_t expected_ = 0;  // records the header says the file holds
   uint64_t count_ = 0;
   uint32_t crc_ = 0;
-  std::FILE* file_ = nullptr;
+  std::string note_;
+  File file_, blocks_;
 };
 
 class Database {
  public:
-  // Maps `path` and checks it: magic, version, header checksum, sizes and (unless
-  // `verify_records` is false) the records' checksum. Throws nphand::Error otherwise.
+  // Maps `path` and checks it: a regular file, magic, version, header checksum and schema
+  // (every field the format defines, with its type, range and agreement with the others),
+  // sizes and, unless `verify_records` is false, the records' checksum and content (each
+  // record is the entry of the enumeration at its place, its numbers finite and in range, a
+  // hand crop where it has a hand). Throws nphand::Error naming the file and the problem.
   static Database Open(const std::filesystem::path& path, bool verify_records = true);
   ~Database();
   Database(Database&& other) noexcept;
@@ -124,6 +146,8 @@ class Database {
  private:
   Database() = default;
   const uint8_t* Record(size_t i) const;
+  // Throws naming the first record whose content the header's enumeration rules out.
+  void VerifyRecords() const;
 
   std::filesystem::path path_;
   nlohmann::json header_;

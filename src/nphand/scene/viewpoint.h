@@ -33,8 +33,12 @@ std::vector<Eigen::Vector3d> ViewSphereDirections(int count);
 struct ViewSphereCoverage {
   double max_neighbour_deg = 0.0;   // the largest angle from a direction to its nearest other one
   double covering_radius_deg = 0.0; // the largest angle from any point of the sphere to the
-                                    // nearest direction (estimated on a dense probe lattice)
+                                    // nearest direction (a spherical Voronoi vertex)
+
 };
+// O(n log n) with exact k-d tree searches (FLANN): the Voronoi vertices are sought among the
+// circumcentres of each direction and two of its 8 nearest, which holds them for any
+// evenly spread set such as the Fibonacci lattice.
 ViewSphereCoverage MeasureCoverage(const std::vector<Eigen::Vector3d>& directions);
 
 // camera_from_hand for a camera placed along ViewDirection and looking back at the hand,

@@ -5,26 +5,20 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <memory>
 
 #include <fcntl.h>
 #include <unistd.h>
 
 #include "nphand/util/check.h"
+#include "nphand/util/file.h"
 
 namespace nphand {
 
 std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  NPHAND_THROW_CHECK(in.good(), path.string(), ": cannot open for reading (", std::strerror(errno), ")");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  NPHAND_THROW_CHECK(size >= 0, path.string(), ": cannot read its size");
-  in.seekg(0, std::ios::beg);
-  std::vector<uint8_t> bytes(static_cast<size_t>(size));
-  in.read(reinterpret_cast<char*>(bytes.data()), size);
-  NPHAND_THROW_CHECK(in.good() || size == 0, path.string(), ": read failed");
+  const File file = File::OpenRegular(path);
+  std::vector<uint8_t> bytes(file.Size());
+  NPHAND_THROW_CHECK(file.ReadAt(0, bytes), path.string(), ": the file shrank while being read");
   return bytes;
 }
 

@@ -9,7 +9,8 @@
 
 namespace nphand {
 
-// Reads a whole file. Throws nphand::Error naming the path when it cannot.
+// Reads a whole regular file. Throws nphand::Error naming the path when it cannot (also
+// for a folder or a FIFO: see File::OpenRegular).
 std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path);
 
 // Writes `bytes` to `path` atomically: a temporary file beside it, flushed, then renamed
