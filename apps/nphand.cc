@@ -1,5 +1,6 @@
 // nphand: one binary, one subcommand per pipeline job. Each subcommand binds its flags to
 // the fields of an options struct and calls the matching Run* function.
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
@@ -12,6 +13,12 @@
 #include "nphand/util/check.h"
 
 namespace {
+
+void AddGraspCheck(CLI::Option* option) {
+  option->check(CLI::Validator(
+      [](std::string& item) { return item.empty() ? std::string("an empty item (expected e.g. 1,13)") : std::string(); },
+      "", "non-empty"));
+}
 
 void AddRenderCommand(CLI::App& app, nphand::RenderCommandOptions& o) {
   CLI::App* cmd = app.add_subcommand("render", "Render a posed hand (and an object) to PNG: RGB, labels, depth, keypoints");
@@ -83,7 +90,7 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
   nphand::DatabaseBuildOptions& b = a.build.build;
   CLI::App* build = db->add_subcommand("build", "Render every grasp, step, object/no object and viewpoint into a database");
   build->add_option("--out", a.build.out, "Database file to write")->capture_default_str();
-  build->add_option("--grasps", b.grasps, "Taxonomy numbers to include (default: all 33)")->delimiter(',');
+  AddGraspCheck(build->add_option("--grasps", b.grasps, "Taxonomy numbers to include (default: all 33)")->delimiter(','));
   build->add_option("--directions", b.directions, "Viewing directions on the sphere")->capture_default_str();
   build->add_option("--image-size", b.image_size, "Rendered image side, pixels")->capture_default_str();
   build->add_option("--threads", b.threads, "Worker threads (0: all cores)")->capture_default_str();
@@ -142,6 +149,25 @@ void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, bool& 
   });
 }
 
+// CLI11 answers an unknown subcommand with "A subcommand is required"; this names it and
+// lists the known ones. Walks the leading words of argv down the subcommand tree.
+void CheckSubcommands(CLI::App& app, int argc, char** argv) {
+  CLI::App* level = &app;
+  std::string path = "nphand";
+  for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {
+    std::vector<CLI::App*> known = level->get_subcommands([](CLI::App*) { return true; });
+    if (known.empty()) return;
+    const auto match = std::find_if(known.begin(), known.end(), [&](CLI::App* sub) { return sub->check_name(argv[i]); });
+    if (match == known.end()) {
+      std::string names;
+      for (CLI::App* sub : known) names += (names.empty() ? "" : ", ") + sub->get_name();
+      throw nphand::Error("'" + path + " " + argv[i] + "' is not a command; '" + path + "' takes: " + names);
+    }
+    level = *match;
+    path += " " + level->get_name();
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -157,6 +183,7 @@ int main(int argc, char** argv) {
   nphand::EvalFeaturesCommandOptions eval_options;
   AddEvalCommand(app, eval_options, json);
   try {
+    CheckSubcommands(app, argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);

@@ -1,5 +1,6 @@
 #include "apps/render_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -11,6 +12,7 @@
 #include "nphand/render/renderer.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/util/check.h"
+#include "nphand/util/file.h"
 
 namespace nphand {
 namespace {
@@ -45,6 +47,14 @@ JointAngles ArticulationOf(const RenderCommandOptions& options) {
 }  // namespace
 
 bool RenderCommandOptions::Check(std::string* why) const {
+  const auto finite = [](const std::vector<double>& values) {
+    return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+  };
+  if (!finite({azimuth_deg, elevation_deg, roll_deg}) || !finite(object_at) || !finite(object_rotate_deg) ||
+      !finite(object_size)) {
+    *why = "--azimuth, --elevation, --roll and the --object-* values must be finite numbers";
+    return false;
+  }
   if (!(distance > 0.05 && distance < 100.0)) {
     *why = "--distance must be between 0.05 and 100 metres";
     return false;
@@ -114,7 +124,6 @@ RenderCommandResult RunGraspSheet(const RenderCommandOptions& options, const Han
     cv::putText(cell, std::to_string(i + 1) + " " + GraspTaxonomy()[i].name, {6, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
                 cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   }
-  std::filesystem::create_directories(options.out_dir);
   const std::filesystem::path path =
       options.out_dir / (options.name + "_grasps_step" + std::to_string(options.step) + ".png");
   WriteImageAtomic(path, sheet);
@@ -128,6 +137,8 @@ RenderCommandResult RunGraspSheet(const RenderCommandOptions& options, const Han
 RenderCommandResult RunRender(const RenderCommandOptions& options) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "render: ", why);
+  CheckFileName(options.name, "render --name");
+  CheckOutputFolder(options.out_dir, "render --out");
   const HandModel model = HandModel::Load(HandednessFromString(options.hand), options.asset_dir);
   const Viewpoint view{options.azimuth_deg * kRadPerDeg, options.elevation_deg * kRadPerDeg, options.roll_deg * kRadPerDeg};
   if (options.grasp == "all") return RunGraspSheet(options, model, view);
@@ -149,7 +160,6 @@ RenderCommandResult RunRender(const RenderCommandOptions& options) {
   cv::Mat depth_mm;
   images.depth.convertTo(depth_mm, CV_16UC1, 1000.0);
 
-  std::filesystem::create_directories(options.out_dir);
   RenderCommandResult result;
   const auto write = [&](const std::string& suffix, const cv::Mat& image) {
     const std::filesystem::path path = options.out_dir / (options.name + "_" + suffix + ".png");

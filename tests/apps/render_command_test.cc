@@ -3,7 +3,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "nphand/util/check.h"
+#include "nphand/util/io.h"
 #include "testing/testing.h"
 
 namespace nphand {
@@ -53,6 +56,40 @@ TEST(RenderCommandTest, BadOptionsGiveErrorsThatNameThem) {
   options.object = "";
   options.hand = "middle";
   expect_error(options, "handedness");
+  // Not-a-number viewpoints and placements used to render blank images and succeed.
+  for (const double bad : {std::nan(""), HUGE_VAL, -HUGE_VAL}) {
+    RenderCommandOptions view;
+    view.azimuth_deg = bad;
+    expect_error(view, "finite");
+    view = {};
+    view.elevation_deg = bad;
+    expect_error(view, "finite");
+    view = {};
+    view.roll_deg = bad;
+    expect_error(view, "finite");
+    view = {};
+    view.object = "sphere";
+    view.object_size = {0.03};
+    view.object_at = {bad, 0, 0};
+    expect_error(view, "finite");
+    view.object_at = {0, 0, 0};
+    view.object_rotate_deg = {0, bad, 0};
+    expect_error(view, "finite");
+  }
+  // A name is a file name: "../x" used to write outside --out.
+  for (const std::string name : {"../x", "a/b", "..", ""}) {
+    RenderCommandOptions named;
+    named.name = name;
+    expect_error(named, "must be a file name");
+  }
+}
+
+TEST(RenderCommandTest, OutputFolderThatIsAFileIsRefused) {
+  const auto dir = testing::ScratchDir();
+  WriteFileAtomic(dir / "file", std::string("x"));
+  RenderCommandOptions options;
+  options.out_dir = dir / "file";
+  EXPECT_THROW(RunRender(options), Error);
 }
 
 }  // namespace

@@ -91,6 +91,31 @@ TEST_F(FeatureStudyTest, BadOptionsAreRefused) {
   FeatureStudyOptions options = Options();
   options.features = {"sift"};
   EXPECT_THROW(RunFeatureStudy(*db_, options, nullptr), Error);
+  // More queries than entries used to be reported as asked, not as run.
+  options = Options();
+  options.queries = 99999999;
+  try {
+    RunFeatureStudy(*db_, options, nullptr);
+    ADD_FAILURE() << "ran 99999999 queries on 160 entries";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("only"), std::string::npos) << e.what();
+  }
+}
+
+// The database is searched a chunk at a time (memory flat in its size); chunks of any size
+// give the same study.
+TEST_F(FeatureStudyTest, ChunkedSearchEqualsOneSearch) {
+  FeatureStudyOptions options = Options();
+  options.normalize_roll = true;
+  const FeatureStudyResult whole = RunFeatureStudy(*db_, options, nullptr);
+  options.chunk = 7;
+  const FeatureStudyResult chunked = RunFeatureStudy(*db_, options, nullptr);
+  for (size_t f = 0; f < whole.curves.size(); ++f) {
+    for (size_t i = 0; i < whole.curves[f].joint_deg.size(); ++i) {
+      EXPECT_NEAR(whole.curves[f].joint_deg[i], chunked.curves[f].joint_deg[i], 1e-9) << whole.curves[f].name;
+      EXPECT_NEAR(whole.curves[f].wrist_deg[i], chunked.curves[f].wrist_deg[i], 1e-9) << whole.curves[f].name;
+    }
+  }
 }
 
 }  // namespace

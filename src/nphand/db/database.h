@@ -146,8 +146,8 @@ class Database {
  private:
   Database() = default;
   const uint8_t* Record(size_t i) const;
-  // Throws naming the first record whose content the header's enumeration rules out.
-  void VerifyRecords() const;
+  // Throws naming the first record of [begin, end) whose content the header rules out.
+  void VerifyRecords(size_t begin, size_t end) const;
 
   std::filesystem::path path_;
   nlohmann::json header_;

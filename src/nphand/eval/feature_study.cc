@@ -60,9 +60,9 @@ struct StudyCrop {
   }
 };
 
-StudyCrop Recrop(const cv::Mat& mask, bool normalize_roll) {
-  const std::optional<HandCrop> crop = CropHand(mask, {kCropBitsSide, 0.1, normalize_roll});
-  NPHAND_CHECK(crop.has_value(), "a database entry with a hand has an empty crop");
+StudyCrop Recrop(const cv::Mat& mask, double margin, bool normalize_roll, size_t entry) {
+  const std::optional<HandCrop> crop = CropHand(mask, {kCropBitsSide, margin, normalize_roll});
+  NPHAND_THROW_CHECK(crop.has_value(), "feature study: database entry ", entry, " has a hand but an empty crop");
   StudyCrop study;
   crop->image.convertTo(study.coverage, CV_8UC1, 255.0);
   study.roll = crop->roll;
@@ -73,21 +73,35 @@ std::vector<float> Describe(const StudyFeature& feature, const cv::Mat& crop) {
   return feature.kind == StudyFeature::Kind::kDistance ? DistanceTransformFeature(crop, 32) : ComputeHog(crop, feature.hog);
 }
 
-// Reorders each query's row of `labels` (`fetch` wide) by symmetric chamfer distance.
-void RerankByChamfer(const std::vector<StudyCrop>& crops, const std::vector<StudyCrop>& query_crops, int fetch,
-                     std::vector<faiss::Index::idx_t>* labels) {
+// A query's nearest candidates so far: (distance, candidate), sorted, at most `fetch`.
+using Nearest = std::vector<std::pair<float, size_t>>;
+
+// Adds one chunk's search results (candidate positions from `first`) to each query's list.
+void MergeNearest(const std::vector<float>& distances, const std::vector<faiss::Index::idx_t>& labels, int found,
+                  size_t first, int fetch, std::vector<Nearest>* nearest) {
+  for (size_t q = 0; q < nearest->size(); ++q) {
+    Nearest& list = (*nearest)[q];
+    for (int r = 0; r < found; ++r) {
+      if (labels[q * found + r] >= 0) list.emplace_back(distances[q * found + r], first + labels[q * found + r]);
+    }
+    const size_t keep = std::min<size_t>(fetch, list.size());
+    std::partial_sort(list.begin(), list.begin() + keep, list.end());
+    list.resize(keep);
+  }
+}
+
+// Reorders each query's list by symmetric chamfer distance between contours.
+void RerankByChamfer(const Database& db, const std::vector<size_t>& candidates, double margin, bool normalize_roll,
+                     const std::vector<StudyCrop>& query_crops, std::vector<Nearest>* nearest) {
   ParallelFor(query_crops.size(), [&](size_t q) {
     const cv::Mat query_edges = EdgeMap(query_crops[q].image());
     const cv::Mat query_distance = ContourDistance(query_edges);
-    std::vector<std::pair<double, faiss::Index::idx_t>> scored;
-    for (int r = 0; r < fetch; ++r) {
-      const faiss::Index::idx_t c = (*labels)[q * fetch + r];
-      const cv::Mat edges = EdgeMap(crops[c].image());
-      const double d = 0.5 * (ChamferDistance(query_edges, ContourDistance(edges)) + ChamferDistance(edges, query_distance));
-      scored.emplace_back(d, c);
+    for (auto& [distance, c] : (*nearest)[q]) {
+      const cv::Mat edges = EdgeMap(Recrop(db.Crop(candidates[c]), margin, normalize_roll, candidates[c]).image());
+      distance = static_cast<float>(
+          0.5 * (ChamferDistance(query_edges, ContourDistance(edges)) + ChamferDistance(edges, query_distance)));
     }
-    std::stable_sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (int r = 0; r < fetch; ++r) (*labels)[q * fetch + r] = scored[r].second;
+    std::stable_sort((*nearest)[q].begin(), (*nearest)[q].end());
   });
 }
 
@@ -121,8 +135,8 @@ std::vector<StudyFeature> PaperFeatures() {
 }
 
 bool FeatureStudyOptions::Check(std::string* why) const {
-  if (queries < 1 || neighbours < 1 || neighbours > 1000) {
-    *why = "the study needs at least one query and 1 to 1000 neighbours";
+  if (queries < 1 || neighbours < 1 || neighbours > 1000 || chunk < 1) {
+    *why = "the study needs at least one query, 1 to 1000 neighbours and a chunk of at least one entry";
     return false;
   }
   for (const std::string& name : features) {
@@ -149,24 +163,27 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
   result.candidates = candidates.size();
   NPHAND_THROW_CHECK(candidates.size() > static_cast<size_t>(options.neighbours) + 2,
                      "feature study: the database has too few entries with a hand");
+  NPHAND_THROW_CHECK(static_cast<size_t>(options.queries) <= candidates.size(), "feature study: ", options.queries,
+                     " queries asked, but the database has only ", candidates.size(), " entries with a hand");
 
   // Queries: a seeded sample of the candidates (positions in `candidates`), each with a roll.
   Random random(options.seed);
   std::vector<size_t> order(candidates.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  const size_t query_count = std::min<size_t>(options.queries, candidates.size());
+  const size_t query_count = options.queries;
   for (size_t i = 0; i < query_count; ++i) std::swap(order[i], order[i + random.UniformIndex(order.size() - i)]);
   std::vector<size_t> queries(order.begin(), order.begin() + query_count);
   std::vector<double> query_turn(query_count, 0.0);
   for (double& turn : query_turn) turn = options.roll_queries ? random.Uniform(-std::numbers::pi, std::numbers::pi) : 0.0;
 
-  // Crops of every candidate and every (turned) query, as the study sees them.
-  if (progress != nullptr) *progress << "feature study: cropping " << candidates.size() << " entries\n";
-  std::vector<StudyCrop> crops(candidates.size()), query_crops(query_count);
-  ParallelFor(candidates.size(), [&](size_t c) { crops[c] = Recrop(db.Crop(candidates[c]), options.normalize_roll); });
+  // The crops of the (turned) queries, as the study sees them.
+  const double margin = db.header()["crop"]["margin"].get<double>();
+  std::vector<StudyCrop> query_crops(query_count);
   ParallelFor(query_count, [&](size_t q) {
-    const cv::Mat mask = db.Crop(candidates[queries[q]]);
-    query_crops[q] = Recrop(query_turn[q] == 0.0 ? mask : RotateMask(mask, query_turn[q]), options.normalize_roll);
+    const size_t entry = candidates[queries[q]];
+    const cv::Mat mask = db.Crop(entry);
+    query_crops[q] =
+        Recrop(query_turn[q] == 0.0 ? mask : RotateMask(mask, query_turn[q]), margin, options.normalize_roll, entry);
   });
 
   // The truth of each query: its joint angles and its (turned) camera rotation. Turning the
@@ -178,55 +195,95 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
                         FromPoseVector(db.Pose(candidates[queries[q]]), Handedness::kRight).camera_from_hand;
   }
 
+  // Each feature's query vectors and, per query, its nearest candidates so far.
+  struct Search {
+    StudyFeature feature;
+    int dimension = 0;
+    int fetch = 0;  // neighbours kept: K and room for the query and its twin, or the re-ranked list
+    std::vector<float> probe;
+    std::vector<Nearest> nearest;
+  };
   const int k = options.neighbours;
+  const auto pose_row = [](const PoseVector& pose, float* row) {
+    for (int d = 0; d < kPoseVectorSize; ++d) row[d] = static_cast<float>(pose[d]);
+  };
+  std::vector<Search> searches;
   for (const StudyFeature& feature : PaperFeatures()) {
     if (!options.features.empty() &&
         std::find(options.features.begin(), options.features.end(), feature.name) == options.features.end()) {
       continue;
     }
-    // Feature vectors of the candidates and of the queries.
-    int dimension = kPoseVectorSize;
-    std::vector<float> base, probe;
+    Search search;
+    search.feature = feature;
+    const bool rerank = feature.kind == StudyFeature::Kind::kChamferRerank;
+    search.fetch = static_cast<int>(std::min<size_t>(rerank ? std::max(kRerank, k + 4) : k + 4, candidates.size()));
+    search.nearest.resize(query_count);
     if (feature.kind == StudyFeature::Kind::kJoints) {
-      base.resize(candidates.size() * dimension);
-      probe.resize(query_count * dimension);
-      for (size_t c = 0; c < candidates.size(); ++c) {
-        const PoseVector pose = db.Pose(candidates[c]);
-        for (int d = 0; d < dimension; ++d) base[c * dimension + d] = static_cast<float>(pose[d]);
-      }
+      search.dimension = kPoseVectorSize;
+      search.probe.resize(query_count * kPoseVectorSize);
       for (size_t q = 0; q < query_count; ++q) {
         HandPose truth = FromPoseVector(db.Pose(candidates[queries[q]]), Handedness::kRight);
         truth.camera_from_hand = query_rotation[q];
-        const PoseVector pose = ToPoseVector(truth);
-        for (int d = 0; d < dimension; ++d) probe[q * dimension + d] = static_cast<float>(pose[d]);
+        pose_row(ToPoseVector(truth), search.probe.data() + q * kPoseVectorSize);
       }
     } else {
-      dimension = static_cast<int>(Describe(feature, crops[0].image()).size());
-      base.resize(candidates.size() * dimension);
-      probe.resize(query_count * dimension);
-      ParallelFor(candidates.size(), [&](size_t c) {
-        const std::vector<float> v = Describe(feature, crops[c].image());
-        std::copy(v.begin(), v.end(), base.begin() + c * dimension);
-      });
+      search.dimension = static_cast<int>(Describe(feature, query_crops[0].image()).size());
+      search.probe.resize(query_count * search.dimension);
       ParallelFor(query_count, [&](size_t q) {
         const std::vector<float> v = Describe(feature, query_crops[q].image());
-        std::copy(v.begin(), v.end(), probe.begin() + q * dimension);
+        std::copy(v.begin(), v.end(), search.probe.begin() + q * search.dimension);
       });
     }
+    searches.push_back(std::move(search));
+  }
 
-    // Exact search; a few spare neighbours make room for the query and its twin.
-    faiss::IndexFlatL2 index(dimension);
-    index.add(static_cast<faiss::Index::idx_t>(candidates.size()), base.data());
-    const bool rerank = feature.kind == StudyFeature::Kind::kChamferRerank;
-    const int fetch = static_cast<int>(std::min<size_t>(rerank ? std::max(kRerank, k + 4) : k + 4, candidates.size()));
-    std::vector<float> distances(query_count * fetch);
-    std::vector<faiss::Index::idx_t> labels(query_count * fetch);
-    index.search(static_cast<faiss::Index::idx_t>(query_count), probe.data(), fetch, distances.data(), labels.data());
-    if (rerank) RerankByChamfer(crops, query_crops, fetch, &labels);
+  // Exact search over the candidates a chunk at a time: only a chunk's crops and features
+  // are in memory, however many entries the database holds.
+  std::vector<double> candidate_roll(candidates.size(), 0.0);
+  std::vector<StudyCrop> crops;
+  std::vector<float> base, distances;
+  std::vector<faiss::Index::idx_t> labels;
+  for (size_t first = 0; first < candidates.size(); first += options.chunk) {
+    const size_t count = std::min(options.chunk, candidates.size() - first);
+    if (progress != nullptr) {
+      *progress << "\rfeature study: searching entries " << first + count << "/" << candidates.size() << std::flush;
+    }
+    crops.assign(count, {});
+    ParallelFor(count, [&](size_t c) {
+      const size_t entry = candidates[first + c];
+      crops[c] = Recrop(db.Crop(entry), margin, options.normalize_roll, entry);
+      candidate_roll[first + c] = crops[c].roll;
+    });
+    for (Search& search : searches) {
+      base.resize(count * search.dimension);
+      if (search.feature.kind == StudyFeature::Kind::kJoints) {
+        for (size_t c = 0; c < count; ++c) pose_row(db.Pose(candidates[first + c]), base.data() + c * kPoseVectorSize);
+      } else {
+        ParallelFor(count, [&](size_t c) {
+          const std::vector<float> v = Describe(search.feature, crops[c].image());
+          std::copy(v.begin(), v.end(), base.begin() + c * search.dimension);
+        });
+      }
+      faiss::IndexFlatL2 index(search.dimension);
+      index.add(static_cast<faiss::Index::idx_t>(count), base.data());
+      const int found = static_cast<int>(std::min<size_t>(search.fetch, count));
+      distances.resize(query_count * found);
+      labels.resize(query_count * found);
+      index.search(static_cast<faiss::Index::idx_t>(query_count), search.probe.data(), found, distances.data(),
+                   labels.data());
+      MergeNearest(distances, labels, found, first, search.fetch, &search.nearest);
+    }
+  }
+  if (progress != nullptr) *progress << "\n";
 
+  for (Search& search : searches) {
+    const StudyFeature& feature = search.feature;
+    if (feature.kind == StudyFeature::Kind::kChamferRerank) {
+      RerankByChamfer(db, candidates, margin, options.normalize_roll, query_crops, &search.nearest);
+    }
     FeatureCurve curve;
     curve.name = feature.name;
-    curve.dimension = dimension;
+    curve.dimension = search.dimension;
     std::vector<double> joint_sum(k, 0.0), wrist_sum(k, 0.0);
     for (size_t q = 0; q < query_count; ++q) {
       const size_t query_entry = candidates[queries[q]];
@@ -234,9 +291,8 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
       const JointAngles query_angles = db.Angles(query_entry);
       double joint_total = 0.0, wrist_total = 0.0;
       int found = 0;
-      for (int r = 0; r < fetch && found < k; ++r) {
-        NPHAND_CHECK(labels[q * fetch + r] >= 0, "exact search returned too few neighbours");
-        const size_t c = static_cast<size_t>(labels[q * fetch + r]);
+      for (size_t r = 0; r < search.nearest[q].size() && found < k; ++r) {
+        const size_t c = search.nearest[q][r].second;
         const size_t entry = candidates[c];
         const EntryMeta meta = db.Meta(entry);
         if (meta.grasp == query_meta.grasp && meta.step == query_meta.step && meta.viewpoint == query_meta.viewpoint) {
@@ -247,7 +303,7 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
         for (int d = 0; d < kNumDofs; ++d) joint += std::abs(angles[d] - query_angles[d]);
         Eigen::Matrix3d rotation = FromPoseVector(db.Pose(entry), Handedness::kRight).camera_from_hand;
         if (options.normalize_roll && feature.kind != StudyFeature::Kind::kJoints) {
-          rotation = camera_roll(query_crops[q].roll - crops[c].roll) * rotation;  // undo the alignment
+          rotation = camera_roll(query_crops[q].roll - candidate_roll[c]) * rotation;  // undo the alignment
         }
         joint_total += joint / kNumDofs * kDegPerRad;
         wrist_total += RotationAngleDeg(rotation, query_rotation[q]);
@@ -255,7 +311,8 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
         wrist_sum[found] += wrist_total / (found + 1);
         ++found;
       }
-      NPHAND_CHECK(found == k, "fewer than K neighbours left after removing the query");
+      NPHAND_THROW_CHECK(found == k, "feature study: fewer than ", k, " neighbours of entry ", query_entry,
+                         " are left after removing it and its twin");
     }
     for (int i = 0; i < k; ++i) {
       curve.joint_deg.push_back(joint_sum[i] / query_count);

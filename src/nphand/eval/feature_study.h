@@ -39,6 +39,7 @@ struct FeatureStudyOptions {
   std::vector<std::string> features; // names from PaperFeatures(); empty: all
   bool roll_queries = false;         // turn each query's hand by a random in-plane angle
   bool normalize_roll = false;       // crop every hand by its principal axis (CropOptions)
+  size_t chunk = 16384;              // database entries cropped and described at once (memory)
 
   bool Check(std::string* why) const;
 };
