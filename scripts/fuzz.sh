@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# Runs every libFuzzer target (tests/fuzz) for a given time each, on top of seeds made from
+# real small files and the corpus kept from earlier runs (.cache/fuzz/), and prints a line
+# per target: executions, corpus size, crashes. Exits non-zero if any target crashed (the
+# input is kept in .cache/fuzz/crashes/ and belongs in a regression test).
+# Usage: scripts/fuzz.sh [--seconds N]   (default 60 per target)
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+seconds=60
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --seconds) seconds="$2"; shift 2 ;;
+    *) echo "usage: scripts/fuzz.sh [--seconds N]" >&2; exit 2 ;;
+  esac
+done
+
+"$root/scripts/setup.sh"
+fuzz_packages=(clang libclang-rt-14-dev libomp-14-dev)
+if [ "$(dpkg-query -W -f='${Status}\n' "${fuzz_packages[@]}" 2>/dev/null | grep -c 'install ok installed')" -eq 3 ]; then
+  echo "fuzz: clang, libFuzzer and OpenMP for clang already installed"
+else
+  sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${fuzz_packages[@]}"
+fi
+
+build="$root/build-fuzz"
+targets=(db_file db_content db_resume)
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DNPHAND_FUZZ=ON -DNPHAND_BUILD_TESTS=OFF -DNPHAND_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" --parallel "$(nproc)" --target nphand "${targets[@]/#/fuzz_}"
+
+# Seeds: a real small database (and a shard of it), split the ways the targets take them.
+cache="$root/.cache/fuzz"
+seeds="$cache/seeds"
+rm -rf "$seeds" "$cache/crashes"
+mkdir -p "$seeds" "$cache/crashes"
+export ASAN_OPTIONS="detect_leaks=1"
+"$build/apps/nphand" db build --grasps 1 --directions 2 --threads 1 --quiet --out "$seeds/tiny.db" >/dev/null
+"$build/apps/nphand" db build --grasps 1 --directions 2 --threads 1 --quiet --shard 1/3 --out "$seeds/shard.db" >/dev/null
+python3 - "$seeds" <<'PY'
+import os, struct, sys, zlib
+seeds = sys.argv[1]
+for t in ("db_file", "db_content", "db_resume"):
+    os.makedirs(os.path.join(seeds, t), exist_ok=True)
+for name in ("tiny", "shard"):
+    data = open(os.path.join(seeds, name + ".db"), "rb").read()
+    header_len = struct.unpack_from("<I", data, 12)[0]
+    header = data[16:16 + header_len]
+    start = (16 + header_len + 4 + 63) // 64 * 64
+    records = data[start:len(data) - 20]
+    open(os.path.join(seeds, "db_file", name), "wb").write(data)
+    open(os.path.join(seeds, "db_content", name), "wb").write(struct.pack("<I", header_len) + header + records)
+    if name == "tiny":
+        # An interrupted build: the prologue, blocks of 4 records with their checksums, a torn record.
+        record = len(records) // 20
+        for kept in (0, 8, 20):
+            partial = data[:start] + records[:kept * record] + records[kept * record:kept * record + 100]
+            blocks = b"NPHBLKS1" + b"".join(
+                struct.pack("<QI", 4, zlib.crc32(records[b * record:(b + 4) * record]))
+                for b in range(0, kept, 4))
+            open(os.path.join(seeds, "db_resume", "kept%d" % kept), "wb").write(
+                struct.pack("<I", len(partial)) + partial + blocks)
+PY
+
+failed=0
+for t in "${targets[@]}"; do
+  corpus="$cache/corpus/$t"
+  mkdir -p "$corpus"
+  log="$cache/$t.log"
+  status=0
+  "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -print_final_stats=1 -rss_limit_mb=4096 \
+    -artifact_prefix="$cache/crashes/${t}-" "$corpus" "$seeds/$t" >"$log" 2>&1 || status=$?
+  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+  crashes=$(find "$cache/crashes" -name "${t}-*" | wc -l)
+  [ "$status" -ne 0 ] && [ "$crashes" -eq 0 ] && crashes=1
+  echo "fuzz: $t: ${execs:-0} executions in ${seconds} s, corpus $(find "$corpus" -type f | wc -l) inputs, crashes $crashes"
+  if [ "$crashes" -ne 0 ]; then
+    failed=1
+    tail -40 "$log"
+  fi
+done
+exit $failed
