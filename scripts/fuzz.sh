@@ -26,7 +26,7 @@ else
 fi
 
 build="$root/build-fuzz"
-targets=(db_file db_content db_resume)
+targets=(db_file db_content db_resume glb)
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DNPHAND_FUZZ=ON -DNPHAND_BUILD_TESTS=OFF -DNPHAND_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" --parallel "$(nproc)" --target nphand "${targets[@]/#/fuzz_}"
@@ -63,6 +63,8 @@ for name in ("tiny", "shard"):
             open(os.path.join(seeds, "db_resume", "kept%d" % kept), "wb").write(
                 struct.pack("<I", len(partial)) + partial + blocks)
 PY
+mkdir -p "$seeds/glb"
+cp "$root/.cache/hand/right.glb" "$root/.cache/hand/left.glb" "$seeds/glb/"
 
 failed=0
 for t in "${targets[@]}"; do

@@ -216,6 +216,22 @@ TEST(BuilderTest, InfoCountsWhatTheFileHolds) {
   EXPECT_EQ(info["features"][0]["dimension"], 512);
   EXPECT_EQ(info["file_bytes"], db.file_bytes());
   EXPECT_GT(info["view_sphere"]["covering_radius_deg"].get<double>(), 30.0) << "8 directions cover the sphere coarsely";
+  EXPECT_EQ(info["view_sphere"]["covering_radius_deg"], db.header()["view_sphere_coverage"]["covering_radius_deg"])
+      << "measured once, at build time";
+}
+
+// A file whose header lacks the coverage (as files from before it was stored) has it
+// measured, as it was before, in O(n log n): 65535 directions used to take minutes.
+TEST(BuilderTest, InfoMeasuresTheCoverageOfOlderFiles) {
+  const auto dir = testing::ScratchDir();
+  const std::vector<uint8_t> bytes = ReadFileBytes(testing::BuildTinyDatabase(dir / "tiny.db"));
+  nlohmann::json header = testing::HeaderOf(bytes);
+  header.erase("view_sphere_coverage");
+  WriteFileAtomic(dir / "older.db", testing::WithHeader(bytes, header));
+  const nlohmann::json info = DescribeDatabase(Database::Open(dir / "older.db"));
+  EXPECT_NEAR(info["view_sphere"]["covering_radius_deg"].get<double>(),
+              DescribeDatabase(Database::Open(dir / "tiny.db"))["view_sphere"]["covering_radius_deg"].get<double>(),
+              1e-4);
 }
 
 TEST(BuilderTest, BadOptionsAreRefused) {

@@ -180,6 +180,18 @@ TEST(HandModelTest, MissingOrAlteredAssetGivesAClearError) {
   }
 }
 
+// A folder named right.glb used to end in std::bad_alloc.
+TEST(HandModelTest, AssetThatIsNotAFileIsRefusedByName) {
+  const auto dir = testing::ScratchDir();
+  std::filesystem::create_directories(dir / "right.glb");
+  try {
+    HandModel::Load(Handedness::kRight, dir);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("right.glb: is a folder"), std::string::npos) << e.what();
+  }
+}
+
 TEST(HandModelTest, GarbageAndForeignGlbAreRefused) {
   const std::vector<uint8_t> garbage(1000, 7);
   EXPECT_THROW(HandModel::FromGlb(garbage, Handedness::kRight, "garbage.glb"), Error);

@@ -1,5 +1,7 @@
 #include "nphand/util/io.h"
 
+#include <sys/stat.h>
+
 #include <gtest/gtest.h>
 
 #include "nphand/util/check.h"
@@ -27,6 +29,22 @@ TEST(IoTest, MissingFileErrorNamesThePath) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos);
   }
+}
+
+TEST(IoTest, OnlyRegularFilesAreReadAndAFifoIsNotWaitedOn) {
+  const auto dir = testing::ScratchDir();
+  ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0600), 0);
+  const auto expect_refused = [](const std::filesystem::path& path, const std::string& needle) {
+    try {
+      ReadFileBytes(path);
+      ADD_FAILURE() << "read " << path;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(path.string() + ": is " + needle), std::string::npos) << e.what();
+    }
+  };
+  expect_refused(dir / "fifo", "a FIFO");
+  expect_refused(dir, "a folder");
+  expect_refused("/dev/null", "a device");
 }
 
 TEST(IoTest, WriteIntoMissingFolderFails) {

@@ -82,6 +82,15 @@ void RenderEntry(const Context& c, uint64_t index, Renderer* renderer, cv::Mat* 
   EncodeEntry(entry, c.layout, record);
 }
 
+// The view sphere's coverage, rounded so that the header's bytes do not hang on the last
+// bits of a floating-point sum.
+nlohmann::json CoverageJson(int directions) {
+  const ViewSphereCoverage coverage = MeasureCoverage(ViewSphereDirections(directions));
+  const auto round = [](double degrees) { return std::round(degrees * 1e4) / 1e4; };
+  return {{"max_neighbour_deg", round(coverage.max_neighbour_deg)},
+          {"covering_radius_deg", round(coverage.covering_radius_deg)}};
+}
+
 std::string Clock(double seconds) {
   const int s = static_cast<int>(std::lround(std::max(0.0, seconds)));
   char text[32];
@@ -152,6 +161,7 @@ nlohmann::json DatabaseBuildOptions::Header() const {
       {"steps", kGraspSteps},
       {"viewpoints", directions},
       {"view_sphere", "fibonacci"},
+      {"view_sphere_coverage", CoverageJson(directions)},
       {"hand", "right"},
       {"hand_asset_sha256", PinnedAssetSha256(Handedness::kRight)},
       {"render", {{"image_size", image_size}, {"fov_deg", fov_deg}, {"distance_m", distance}}},
@@ -303,13 +313,12 @@ nlohmann::json DescribeDatabase(const Database& db) {
       {"crop", header["crop"]},
       {"normalize_roll", header["hog"].value("normalize_roll", false)},
   };
-  const int directions = header.value("viewpoints", 0);
-  if (directions >= 2) {
-    const ViewSphereCoverage coverage = MeasureCoverage(ViewSphereDirections(directions));
-    info["view_sphere"] = {{"directions", directions},
-                           {"max_neighbour_deg", coverage.max_neighbour_deg},
-                           {"covering_radius_deg", coverage.covering_radius_deg}};
-  }
+  // Files from before the coverage was stored in the header have it measured here.
+  const nlohmann::json coverage =
+      header.contains("view_sphere_coverage") ? header["view_sphere_coverage"] : CoverageJson(header["viewpoints"].get<int>());
+  info["view_sphere"] = {{"directions", header["viewpoints"]},
+                         {"max_neighbour_deg", coverage["max_neighbour_deg"]},
+                         {"covering_radius_deg", coverage["covering_radius_deg"]}};
   if (header.contains("shard")) info["shard"] = header["shard"];
   return info;
 }

@@ -195,6 +195,11 @@ void ValidateHeader(const nlohmann::json& header, const std::string& source) {
   f.Expect(f.String(header, "hand", "hand") == "right", "hand", "must be \"right\" (the database holds right hands)");
   f.Expect(f.String(header, "view_sphere", "view_sphere") == "fibonacci", "view_sphere", "must be \"fibonacci\"");
   f.String(header, "order", "order");
+  if (header.contains("view_sphere_coverage")) {  // optional: older files lack it
+    const nlohmann::json& coverage = f.Object(header, "view_sphere_coverage", "view_sphere_coverage");
+    f.Number(coverage, "max_neighbour_deg", "view_sphere_coverage.max_neighbour_deg", 0.0, 180.0);
+    f.Number(coverage, "covering_radius_deg", "view_sphere_coverage.covering_radius_deg", 0.0, 180.0);
+  }
   f.String(header, "hand_asset_sha256", "hand_asset_sha256");
 
   const nlohmann::json& grasps = f.Array(header, "grasps", "grasps");

@@ -1,0 +1,55 @@
+#include "apps/db_command.h"
+
+#include <functional>
+
+#include <gtest/gtest.h>
+
+#include "apps/eval_command.h"
+#include "nphand/util/check.h"
+#include "testing/testing.h"
+
+namespace nphand {
+namespace {
+
+void ExpectError(const std::function<void()>& call, const std::string& needle) {
+  try {
+    call();
+    ADD_FAILURE() << "no error (expected: " << needle << ")";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+// "0/2x" and "0/2/3" used to be taken as 0/2.
+TEST(DbCommandTest, ShardMustBeExactlyTwoNumbers) {
+  for (const std::string shard : {"0/2x", "0/2/3", "x", "0/", "/2", " 0/2", "0/2 "}) {
+    DbBuildCommandOptions options;
+    options.shard = shard;
+    options.out = testing::ScratchDir() / "x.db";
+    ExpectError([&] { RunDbBuild(options); }, "--shard '" + shard + "': expected i/N");
+  }
+}
+
+TEST(DbCommandTest, DestinationIsCheckedBeforeTheBuild) {
+  DbBuildCommandOptions options;
+  options.out = testing::ScratchDir();
+  options.asset_dir = "/nonexistent";  // were the hand loaded first, this would be the error
+  ExpectError([&] { RunDbBuild(options); }, "is a folder");
+  options.out = "";
+  ExpectError([&] { RunDbBuild(options); }, "the output path is empty");
+  ExpectError([&] { RunDbMerge({"a.db", "b.db"}, testing::ScratchDir()); }, "is a folder");
+}
+
+TEST(DbCommandTest, StudyOutputIsCheckedBeforeTheStudy) {
+  EvalFeaturesCommandOptions options;
+  options.db = "/nonexistent.db";  // were the study run first, this would be the error
+  options.out_dir = testing::ScratchDir();
+  options.name = "../x";
+  ExpectError([&] { RunEvalFeatures(options); }, "must be a file name");
+  options.name = "study";
+  options.out_dir = "/dev/null";
+  ExpectError([&] { RunEvalFeatures(options); }, "is a file, not a folder");
+}
+
+}  // namespace
+}  // namespace nphand
