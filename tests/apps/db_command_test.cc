@@ -1,7 +1,5 @@
 #include "apps/db_command.h"
 
-#include <functional>
-
 #include <gtest/gtest.h>
 
 #include "apps/eval_command.h"
@@ -11,14 +9,7 @@
 namespace nphand {
 namespace {
 
-void ExpectError(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "no error (expected: " << needle << ")";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
+using testing::ExpectError;
 
 // "0/2x" and "0/2/3" used to be taken as 0/2.
 TEST(DbCommandTest, ShardMustBeExactlyTwoNumbers) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "nphand/util/check.h"
+
 namespace nphand::testing {
 
 const HandModel& RightHand() {
@@ -27,6 +29,15 @@ std::filesystem::path ScratchDir() {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+void ExpectError(const std::function<void()>& call, const std::string& needle) {
+  try {
+    call();
+    ADD_FAILURE() << "no error (expected: " << needle << ")";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace nphand::testing

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
+#include <string>
 
 #include "nphand/model/hand_model.h"
 
@@ -13,6 +15,9 @@ const HandModel& LeftHand();
 
 // A fresh empty folder for the running test, under the system's temporary folder.
 std::filesystem::path ScratchDir();
+
+// Expects `call` to throw nphand::Error with `needle` in its message.
+void ExpectError(const std::function<void()>& call, const std::string& needle);
 
 // The seed each test should use: fixed, and printed by the test main on failure.
 inline constexpr uint64_t kTestSeed = 20131108;

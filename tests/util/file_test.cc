@@ -1,7 +1,5 @@
 #include "nphand/util/file.h"
 
-#include <functional>
-
 #include <gtest/gtest.h>
 
 #include "nphand/util/check.h"
@@ -11,14 +9,7 @@
 namespace nphand {
 namespace {
 
-void ExpectError(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "no error (expected: " << needle << ")";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
+using testing::ExpectError;
 
 TEST(FileTest, SecondLockOfAFileIsRefusedUntilTheFirstCloses) {
   const auto path = testing::ScratchDir() / "x.partial";

@@ -147,7 +147,7 @@ struct Enumeration {
 };
 
 // Whether every float of `p` is a number in [min, max]. Written without early exits, so
-// that it vectorises: verifying the default database's records costs less than its CRC.
+// that it vectorises.
 bool AllInRange(const uint8_t* p, size_t count, float min, float max) {
   bool ok = true;
   for (size_t i = 0; i < count; ++i) {
