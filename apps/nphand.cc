@@ -94,7 +94,7 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
   build->add_option("--directions", b.directions, "Viewing directions on the sphere")->capture_default_str();
   build->add_option("--image-size", b.image_size, "Rendered image side, pixels")->capture_default_str();
   build->add_option("--threads", b.threads, "Worker threads (0: all cores)")->capture_default_str();
-  build->add_flag("!--raw-roll", b.normalize_roll,
+  build->add_flag("!--raw-roll", b.descriptor.normalize_roll,
                   "Describe hands as rendered instead of turned by their principal axis");
   build->add_option("--shard", a.build.shard, "Build part i of N (i/N), to merge later with db merge");
   build->add_option("--asset-dir", a.build.asset_dir, "Folder holding right.glb")->capture_default_str();

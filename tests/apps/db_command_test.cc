@@ -4,6 +4,7 @@
 
 #include "apps/eval_command.h"
 #include "nphand/util/check.h"
+#include "nphand/util/io.h"
 #include "testing/testing.h"
 
 namespace nphand {
@@ -38,7 +39,8 @@ TEST(DbCommandTest, StudyOutputIsCheckedBeforeTheStudy) {
   options.name = "../x";
   ExpectError([&] { RunEvalFeatures(options); }, "must be a file name");
   options.name = "study";
-  options.out_dir = "/dev/null";
+  options.out_dir = testing::ScratchDir() / "a_file";
+  WriteFileAtomic(options.out_dir, std::string("x"));
   ExpectError([&] { RunEvalFeatures(options); }, "is a file, not a folder");
 }
 

@@ -140,7 +140,7 @@ TEST(BuilderTest, PartialFileWithoutBlockChecksumsIsStartedAfresh) {
 TEST(BuilderTest, PartialFileOfOtherOptionsIsStartedAfreshAndSaidSo) {
   const auto dir = testing::ScratchDir();
   DatabaseBuildOptions other = TinyDatabaseOptions();
-  other.normalize_roll = false;
+  other.descriptor.normalize_roll = false;
   {
     DatabaseWriter writer(dir / "tiny.db", other.Header(), DatabaseWriter::Mode::kFresh);
   }
@@ -154,7 +154,7 @@ TEST(BuilderTest, PartialFileOfOtherOptionsIsStartedAfreshAndSaidSo) {
 TEST(BuilderTest, SecondBuildIntoTheSamePathIsRefusedWhileTheFirstRuns) {
   const auto dir = testing::ScratchDir();
   DatabaseBuildOptions raw = TinyDatabaseOptions();
-  raw.normalize_roll = false;
+  raw.descriptor.normalize_roll = false;
   DatabaseWriter running(dir / "x.db", raw.Header(), DatabaseWriter::Mode::kResume);
   try {
     BuildDatabase(RightHand(), TinyDatabaseOptions(), dir / "x.db", nullptr);

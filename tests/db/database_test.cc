@@ -24,8 +24,8 @@ nlohmann::json SyntheticHeader(int directions, int shards) {
   DatabaseBuildOptions options;
   options.grasps = {1};
   options.directions = directions;
-  options.hog.cells = 2;
-  options.hog.bins = 4;  // 16 values
+  options.descriptor.hog.cells = 2;
+  options.descriptor.hog.bins = 4;  // 16 values
   options.shard_count = shards;
   return options.Header();
 }
@@ -237,6 +237,7 @@ TEST(DatabaseTest, TinyBuiltDatabaseOpensAndHoldsHandCrops) {
     EXPECT_NEAR(norm, 1.0, 1e-4) << i;
   }
   EXPECT_GT(with_hand, 150);
+  EXPECT_EQ(db.descriptor(), testing::TinyDatabaseOptions().descriptor) << "the file says how it was described";
 }
 
 }  // namespace

@@ -5,13 +5,13 @@
 #include <cmath>
 #include <numbers>
 #include <set>
-#include <thread>
 
 #include "nphand/render/renderer.h"
 #include "nphand/scene/grasp.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
+#include "nphand/util/parallel.h"
 
 namespace nphand {
 namespace {
@@ -66,13 +66,12 @@ void RenderEntry(const Context& c, uint64_t index, Renderer* renderer, cv::Mat* 
   entry.angles = scene.hand.angles;
   entry.keypoints = c.hand.KeypointsOf(scene.hand);
   const cv::Mat mask = *labels == static_cast<int>(PixelLabel::kHand);
-  const std::optional<HandCrop> crop = CropHand(mask, {kCropBitsSide, c.options.crop_margin});
+  const std::optional<HandCrop> crop = CropHand(mask, {kCropBitsSide, c.options.descriptor.crop_margin});
   if (crop.has_value()) {
-    const HandCrop described =
-        c.options.normalize_roll ? *CropHand(mask, {kCropBitsSide, c.options.crop_margin, true}) : *crop;
+    const Descriptor descriptor = *Describe(mask, c.options.descriptor);
     entry.meta.has_hand = true;
-    entry.meta.roll = static_cast<float>(described.roll);
-    entry.hog = ComputeHog(described.image, c.options.hog);
+    entry.meta.roll = static_cast<float>(descriptor.roll);
+    entry.hog = descriptor.values;
     entry.crop = crop->image >= 0.5f;
   } else {
     ++*no_hand;
@@ -123,17 +122,16 @@ bool DatabaseBuildOptions::Check(std::string* why) const {
     *why = "threads must be between 0 (all cores) and 256";
     return false;
   }
-  const CropOptions crop{kCropBitsSide, crop_margin};
   const Intrinsics intrinsics = Intrinsics::FromFieldOfView(image_size, image_size, fov_deg * std::numbers::pi / 180.0);
   if (!(distance > 0.1 && distance < 10.0) || !(fov_deg > 5.0 && fov_deg < 120.0)) {
     *why = "distance must be within (0.1, 10) metres and the field of view within (5, 120) degrees";
     return false;
   }
-  if (kCropBitsSide % hog.cells != 0) {
-    *why = "the HOG cell count must divide the crop side " + std::to_string(kCropBitsSide);
+  if (descriptor.crop_size != kCropBitsSide) {
+    *why = "the descriptor's crop must be the stored crop's side, " + std::to_string(kCropBitsSide);
     return false;
   }
-  return crop.Check(why) && hog.Check(why) && intrinsics.Check(why);
+  return descriptor.Check(why) && intrinsics.Check(why);
 }
 
 uint64_t DatabaseBuildOptions::TotalEntries() const {
@@ -142,7 +140,7 @@ uint64_t DatabaseBuildOptions::TotalEntries() const {
 
 nlohmann::json DatabaseBuildOptions::Header() const {
   RecordLayout layout;
-  layout.hog_dimension = hog.Dimension();
+  layout.hog_dimension = descriptor.Dimension();
   const auto [begin, end] = ShardRange(*this);
   nlohmann::json objects = nlohmann::json::array();
   for (int id : GraspsOf(*this)) {
@@ -165,16 +163,16 @@ nlohmann::json DatabaseBuildOptions::Header() const {
       {"hand", "right"},
       {"hand_asset_sha256", PinnedAssetSha256(Handedness::kRight)},
       {"render", {{"image_size", image_size}, {"fov_deg", fov_deg}, {"distance_m", distance}}},
-      {"crop", {{"size", kCropBitsSide}, {"margin", crop_margin}}},
+      {"crop", {{"size", descriptor.crop_size}, {"margin", descriptor.crop_margin}}},
       {"hog",
-       {{"name", hog.Name()},
-        {"cells", hog.cells},
-        {"bins", hog.bins},
-        {"pyramid", hog.pyramid},
-        {"signed", hog.signed_orientation},
-        {"normalization", ToString(hog.normalization)},
-        {"normalize_roll", normalize_roll},
-        {"dimension", hog.Dimension()}}},
+       {{"name", descriptor.hog.Name()},
+        {"cells", descriptor.hog.cells},
+        {"bins", descriptor.hog.bins},
+        {"pyramid", descriptor.hog.pyramid},
+        {"signed", descriptor.hog.signed_orientation},
+        {"normalization", ToString(descriptor.hog.normalization)},
+        {"normalize_roll", descriptor.normalize_roll},
+        {"dimension", descriptor.Dimension()}}},
   };
   if (shard_count > 1) {
     header["shard"] = {{"index", shard_index}, {"count", shard_count}, {"begin", begin}, {"end", end}};
@@ -193,7 +191,7 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
   Context c{hand, options, GraspsOf(options), {}, ViewSphereDirections(options.directions),
             Intrinsics::FromFieldOfView(options.image_size, options.image_size, options.fov_deg * std::numbers::pi / 180.0),
             {}};
-  c.layout.hog_dimension = options.hog.Dimension();
+  c.layout.hog_dimension = options.descriptor.Dimension();
   for (int id : c.grasp_ids) c.grasps.push_back(MakeGrasp(hand, GraspTaxonomy()[id - 1]));
 
   DatabaseWriter writer(path, options.Header(), DatabaseWriter::Mode::kResume);
@@ -203,25 +201,19 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
   summary.resume_note = writer.resume_note();
   if (progress != nullptr && !summary.resume_note.empty()) *progress << "db build: " << summary.resume_note << "\n";
 
-  const int threads = options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const int threads = ThreadCount(options.threads);
   const size_t record_bytes = c.layout.RecordBytes();
   std::vector<uint8_t> batch(kBatch * record_bytes);
+  std::vector<Renderer> renderers(threads, Renderer(hand));
+  std::vector<cv::Mat> labels(threads);
   std::vector<uint64_t> no_hand(threads, 0);
   double last_report = -1.0;  // progress at most once a second
   for (uint64_t first = begin + summary.resumed; first < end; first += kBatch) {
     const uint64_t count = std::min<uint64_t>(kBatch, end - first);
-    std::vector<std::thread> workers;
-    for (int t = 0; t < threads; ++t) {
-      workers.emplace_back([&, t]() {
-        Renderer renderer(hand);
-        cv::Mat labels;
-        for (uint64_t i = t; i < count; i += threads) {
-          RenderEntry(c, first + i, &renderer, &labels, std::span<uint8_t>(batch.data() + i * record_bytes, record_bytes),
-                      &no_hand[t]);
-        }
-      });
-    }
-    for (std::thread& worker : workers) worker.join();
+    ParallelFor(count, threads, [&](size_t i, int worker) {
+      RenderEntry(c, first + i, &renderers[worker], &labels[worker],
+                  std::span<uint8_t>(batch.data() + i * record_bytes, record_bytes), &no_hand[worker]);
+    });
     writer.Append(std::span<const uint8_t>(batch.data(), count * record_bytes));
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (progress != nullptr && (seconds >= last_report + 1.0 || first + count == end)) {

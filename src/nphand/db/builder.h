@@ -11,8 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "nphand/db/database.h"
-#include "nphand/features/crop.h"
-#include "nphand/features/hog.h"
+#include "nphand/features/descriptor.h"
 #include "nphand/model/hand_model.h"
 
 namespace nphand {
@@ -23,12 +22,11 @@ struct DatabaseBuildOptions {
   int image_size = 128;        // rendered label image side, pixels
   double fov_deg = 30.0;       // horizontal field of view
   double distance = 0.5;       // camera to hand centre, metres
-  double crop_margin = 0.1;    // see CropOptions (the crop side is kCropBitsSide)
-  HogOptions hog;              // the stored descriptor (default 8 x 8 cells x 8 bins)
-  // Describe each hand turned by its principal axis (CropOptions::normalize_roll) and store
-  // the turn, so that the in-plane roll of a query does not matter and can be recovered
+  // The stored descriptor (crop margin, roll normalisation, HOG 8 x 8 cells x 8 bins); its
+  // crop_size must be kCropBitsSide. Roll is normalised by default and each entry's turn
+  // stored, so that the in-plane roll of a query does not matter and can be recovered
   // (docs/feature_study.md measures why).
-  bool normalize_roll = true;
+  DescriptorConfig descriptor;
   int threads = 0;             // 0: all cores
   int shard_index = 0;         // build only part shard_index of shard_count (contiguous)
   int shard_count = 1;

@@ -124,6 +124,21 @@ RecordLayout LayoutOf(const nlohmann::json& header, const std::string& source) {
   return layout;
 }
 
+// The descriptor config a (validated) header records.
+DescriptorConfig DescriptorOf(const nlohmann::json& header) {
+  DescriptorConfig config;
+  config.crop_size = header["crop"]["size"].get<int>();
+  config.crop_margin = header["crop"]["margin"].get<double>();
+  const nlohmann::json& hog = header["hog"];
+  config.normalize_roll = hog["normalize_roll"].get<bool>();
+  config.hog.cells = hog["cells"].get<int>();
+  config.hog.bins = hog["bins"].get<int>();
+  config.hog.pyramid = hog["pyramid"].get<bool>();
+  config.hog.signed_orientation = hog["signed"].get<bool>();
+  config.hog.normalization = HogNormalizationFromString(hog["normalization"].get<std::string>());
+  return config;
+}
+
 // Where the records of a (validated) header sit in the full enumeration.
 struct Enumeration {
   std::vector<int> grasps;
@@ -430,6 +445,7 @@ Database Database::Open(const std::filesystem::path& path, bool verify_records) 
   auto [header, data] = ReadPrologue(db.mapped_, size, source);
   db.header_ = std::move(header);
   db.layout_ = LayoutOf(db.header_, source);
+  db.descriptor_ = DescriptorOf(db.header_);
   const size_t record_bytes = db.layout_.RecordBytes();
   NPHAND_THROW_CHECK(size >= data + kFooterBytes, source, ": truncated (no footer)");
   const uint8_t* footer = db.mapped_ + size - kFooterBytes;
@@ -507,6 +523,7 @@ Database& Database::operator=(Database&& other) noexcept {
     path_ = std::move(other.path_);
     header_ = std::move(other.header_);
     layout_ = other.layout_;
+    descriptor_ = other.descriptor_;
     mapped_ = std::exchange(other.mapped_, nullptr);
     mapped_bytes_ = std::exchange(other.mapped_bytes_, 0);
     records_ = std::exchange(other.records_, nullptr);

@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "nphand/features/descriptor.h"
 #include "nphand/model/hand_model.h"
 #include "nphand/util/file.h"
 
@@ -131,6 +132,8 @@ class Database {
   size_t size() const { return count_; }
   const nlohmann::json& header() const { return header_; }
   const RecordLayout& layout() const { return layout_; }
+  // How the stored HOG was computed: a query must be described the same way.
+  const DescriptorConfig& descriptor() const { return descriptor_; }
   uint64_t file_bytes() const { return mapped_bytes_; }
 
   EntryMeta Meta(size_t i) const;
@@ -152,6 +155,7 @@ class Database {
   std::filesystem::path path_;
   nlohmann::json header_;
   RecordLayout layout_;
+  DescriptorConfig descriptor_;
   const uint8_t* mapped_ = nullptr;
   size_t mapped_bytes_ = 0;
   const uint8_t* records_ = nullptr;

@@ -7,7 +7,6 @@
 #include <map>
 #include <numbers>
 #include <sstream>
-#include <thread>
 
 #include <faiss/IndexFlat.h>
 #include <opencv2/imgproc.hpp>
@@ -15,6 +14,7 @@
 #include "nphand/features/crop.h"
 #include "nphand/features/distance.h"
 #include "nphand/util/check.h"
+#include "nphand/util/parallel.h"
 #include "nphand/util/random.h"
 
 namespace nphand {
@@ -33,19 +33,6 @@ const std::map<std::string, std::vector<double>>& PaperFigures() {
       {"dist32", {1.64}},                         {"chamfer_rerank", {2.07}},
   };
   return kFigures;
-}
-
-// Runs body(i) for i in [0, n) on all cores; each i is independent.
-template <typename Body>
-void ParallelFor(size_t n, Body body) {
-  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-  std::vector<std::thread> workers;
-  for (unsigned t = 0; t < threads; ++t) {
-    workers.emplace_back([&, t]() {
-      for (size_t i = t; i < n; i += threads) body(i);
-    });
-  }
-  for (std::thread& w : workers) w.join();
 }
 
 // A crop kept as 8-bit coverage (a quarter of the float's memory: 0.9 GB for the default
@@ -93,7 +80,7 @@ void MergeNearest(const std::vector<float>& distances, const std::vector<faiss::
 // Reorders each query's list by symmetric chamfer distance between contours.
 void RerankByChamfer(const Database& db, const std::vector<size_t>& candidates, double margin, bool normalize_roll,
                      const std::vector<StudyCrop>& query_crops, std::vector<Nearest>* nearest) {
-  ParallelFor(query_crops.size(), [&](size_t q) {
+  ParallelFor(query_crops.size(), 0, [&](size_t q, int) {
     const cv::Mat query_edges = EdgeMap(query_crops[q].image());
     const cv::Mat query_distance = ContourDistance(query_edges);
     for (auto& [distance, c] : (*nearest)[q]) {
@@ -177,9 +164,9 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
   for (double& turn : query_turn) turn = options.roll_queries ? random.Uniform(-std::numbers::pi, std::numbers::pi) : 0.0;
 
   // The crops of the (turned) queries, as the study sees them.
-  const double margin = db.header()["crop"]["margin"].get<double>();
+  const double margin = db.descriptor().crop_margin;
   std::vector<StudyCrop> query_crops(query_count);
-  ParallelFor(query_count, [&](size_t q) {
+  ParallelFor(query_count, 0, [&](size_t q, int) {
     const size_t entry = candidates[queries[q]];
     const cv::Mat mask = db.Crop(entry);
     query_crops[q] =
@@ -229,7 +216,7 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
     } else {
       search.dimension = static_cast<int>(Describe(feature, query_crops[0].image()).size());
       search.probe.resize(query_count * search.dimension);
-      ParallelFor(query_count, [&](size_t q) {
+      ParallelFor(query_count, 0, [&](size_t q, int) {
         const std::vector<float> v = Describe(feature, query_crops[q].image());
         std::copy(v.begin(), v.end(), search.probe.begin() + q * search.dimension);
       });
@@ -249,7 +236,7 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
       *progress << "\rfeature study: searching entries " << first + count << "/" << candidates.size() << std::flush;
     }
     crops.assign(count, {});
-    ParallelFor(count, [&](size_t c) {
+    ParallelFor(count, 0, [&](size_t c, int) {
       const size_t entry = candidates[first + c];
       crops[c] = Recrop(db.Crop(entry), margin, options.normalize_roll, entry);
       candidate_roll[first + c] = crops[c].roll;
@@ -259,7 +246,7 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
       if (search.feature.kind == StudyFeature::Kind::kJoints) {
         for (size_t c = 0; c < count; ++c) pose_row(db.Pose(candidates[first + c]), base.data() + c * kPoseVectorSize);
       } else {
-        ParallelFor(count, [&](size_t c) {
+        ParallelFor(count, 0, [&](size_t c, int) {
           const std::vector<float> v = Describe(search.feature, crops[c].image());
           std::copy(v.begin(), v.end(), base.begin() + c * search.dimension);
         });
