@@ -9,6 +9,7 @@
 #include "apps/bench_command.h"
 #include "apps/db_command.h"
 #include "apps/eval_command.h"
+#include "apps/index_command.h"
 #include "apps/render_command.h"
 #include "nphand/util/check.h"
 
@@ -121,6 +122,27 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
   info->callback([&a]() { PrintJson(nphand::RunDbInfo(a.info_path), a.json); });
 }
 
+struct IndexArgs {
+  nphand::IndexBuildCommandOptions build;
+  std::filesystem::path info_path = "out/nphand.db.idx";
+  bool json = false;
+};
+
+void AddIndexCommand(CLI::App& app, IndexArgs& a) {
+  CLI::App* index = app.add_subcommand("index", "Build and inspect the nearest-neighbour index of a database");
+  index->require_subcommand(1);
+  CLI::App* build = index->add_subcommand("build", "Index every database entry with a hand for K-nearest search");
+  build->add_option("--db", a.build.db, "Database file")->capture_default_str();
+  build->add_option("--backend", a.build.index.backend, "exact")->capture_default_str();
+  build->add_option("--out", a.build.out, "Index file to write (default: the database's path + .idx)");
+  build->add_flag("--json", a.json, "Print one JSON object");
+  build->callback([&a]() { PrintJson(nphand::RunIndexBuild(a.build), a.json); });
+  CLI::App* info = index->add_subcommand("info", "What an index file holds (backend, parameters, its database)");
+  info->add_option("path", a.info_path, "Index file")->capture_default_str();
+  info->add_flag("--json", a.json, "Print one JSON object");
+  info->callback([&a]() { PrintJson(nphand::RunIndexInfo(a.info_path), a.json); });
+}
+
 void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, bool& json) {
   CLI::App* eval = app.add_subcommand("eval", "The paper's experiments");
   eval->require_subcommand(1);
@@ -180,6 +202,8 @@ int main(int argc, char** argv) {
   AddBenchCommand(app, bench_options, json);
   DbArgs db_args;
   AddDbCommand(app, db_args);
+  IndexArgs index_args;
+  AddIndexCommand(app, index_args);
   nphand::EvalFeaturesCommandOptions eval_options;
   AddEvalCommand(app, eval_options, json);
   try {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <optional>
 #include <set>
@@ -459,6 +460,10 @@ Database Database::Open(const std::filesystem::path& path, bool verify_records) 
                      db.header_["entries"].get<uint64_t>(), " entries, the file holds ", count);
   db.records_ = db.mapped_ + data;
   db.count_ = count;
+  char checksum[17];
+  std::snprintf(checksum, sizeof(checksum), "%08x%08x", Get<uint32_t>(db.mapped_ + 16 + Get<uint32_t>(db.mapped_ + 12)),
+                Get<uint32_t>(footer + 16));
+  db.checksum_ = checksum;
   if (verify_records) {
     // A block at a time, its content checked while it is in the cache. A file that fails its
     // checksum is reported as such: its odd content is damage, not a craft.
@@ -524,6 +529,7 @@ Database& Database::operator=(Database&& other) noexcept {
     header_ = std::move(other.header_);
     layout_ = other.layout_;
     descriptor_ = other.descriptor_;
+    checksum_ = std::move(other.checksum_);
     mapped_ = std::exchange(other.mapped_, nullptr);
     mapped_bytes_ = std::exchange(other.mapped_bytes_, 0);
     records_ = std::exchange(other.records_, nullptr);

@@ -135,6 +135,9 @@ class Database {
   // How the stored HOG was computed: a query must be described the same way.
   const DescriptorConfig& descriptor() const { return descriptor_; }
   uint64_t file_bytes() const { return mapped_bytes_; }
+  // The header's and the records' CRC-32 as 16 hex digits: what an index records of the
+  // database it was built from.
+  const std::string& checksum() const { return checksum_; }
 
   EntryMeta Meta(size_t i) const;
   PoseVector Pose(size_t i) const;
@@ -156,6 +159,7 @@ class Database {
   nlohmann::json header_;
   RecordLayout layout_;
   DescriptorConfig descriptor_;
+  std::string checksum_;
   const uint8_t* mapped_ = nullptr;
   size_t mapped_bytes_ = 0;
   const uint8_t* records_ = nullptr;

@@ -73,7 +73,32 @@ std::optional<Descriptor> Describe(const cv::Mat& mask, const DescriptorConfig& 
   NPHAND_THROW_CHECK(config.Check(&why), "descriptor: ", why);
   const std::optional<HandCrop> crop = CropHand(mask, config.Crop());
   if (!crop.has_value()) return std::nullopt;
-  return Descriptor{ComputeHog(crop->image, config.hog), crop->roll};
+  return Descriptor{config, ComputeHog(crop->image, config.hog), crop->roll};
+}
+
+DescriptorMatrix::DescriptorMatrix(const DescriptorConfig& config, size_t rows)
+    : DescriptorMatrix(config, std::vector<float>(rows * config.Dimension(), 0.0f)) {}
+
+DescriptorMatrix::DescriptorMatrix(const DescriptorConfig& config, std::vector<float> values)
+    : config_(config), dimension_(config.Dimension()), values_(std::move(values)) {
+  NPHAND_THROW_CHECK(values_.size() % dimension_ == 0, "descriptor matrix: ", values_.size(),
+                     " values are not whole rows of ", dimension_);
+  rows_ = values_.size() / dimension_;
+}
+
+std::span<const float> DescriptorMatrix::Row(size_t i) const {
+  NPHAND_CHECK(i < rows_, "row ", i, " of ", rows_);
+  return {values_.data() + i * dimension_, static_cast<size_t>(dimension_)};
+}
+
+std::span<float> DescriptorMatrix::MutableRow(size_t i) {
+  NPHAND_CHECK(i < rows_, "row ", i, " of ", rows_);
+  return {values_.data() + i * dimension_, static_cast<size_t>(dimension_)};
+}
+
+void CheckSameDescriptor(const DescriptorConfig& expected, const DescriptorConfig& actual, const std::string& what) {
+  NPHAND_THROW_CHECK(expected == actual, what, ": described as ", actual.ToString(), ", but ", expected.ToString(),
+                     " is expected");
 }
 
 }  // namespace nphand

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -40,9 +41,36 @@ nlohmann::json ToJson(const DescriptorConfig& config);
 DescriptorConfig DescriptorConfigFromJson(const nlohmann::json& json, const std::string& source);
 
 struct Descriptor {
+  DescriptorConfig config;    // how it was computed
   std::vector<float> values;  // config.Dimension() values
   double roll = 0.0;          // radians the mask was turned before it was described
 };
+
+// Descriptors of one config, one per row, contiguous (row-major), as every index backend
+// takes them.
+class DescriptorMatrix {
+ public:
+  // `rows` rows of zeros.
+  DescriptorMatrix(const DescriptorConfig& config, size_t rows);
+  // Takes `values`; throws nphand::Error unless it holds whole rows.
+  DescriptorMatrix(const DescriptorConfig& config, std::vector<float> values);
+
+  const DescriptorConfig& config() const { return config_; }
+  size_t rows() const { return rows_; }
+  int dimension() const { return dimension_; }
+  std::span<const float> Row(size_t i) const;
+  std::span<float> MutableRow(size_t i);
+  const std::vector<float>& values() const { return values_; }
+
+ private:
+  DescriptorConfig config_;
+  int dimension_ = 0;
+  size_t rows_ = 0;
+  std::vector<float> values_;
+};
+
+// Throws nphand::Error, naming `what` and both configs, unless `actual` equals `expected`.
+void CheckSameDescriptor(const DescriptorConfig& expected, const DescriptorConfig& actual, const std::string& what);
 
 // The descriptor of the non-zero pixels of `mask` (CV_8UC1); std::nullopt when it has none
 // ("no hand"). Throws nphand::Error for an invalid config or mask.

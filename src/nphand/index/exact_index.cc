@@ -1,0 +1,36 @@
+#include "nphand/index/exact_index.h"
+
+#include <algorithm>
+
+namespace nphand {
+
+float SquaredDistance(std::span<const float> a, std::span<const float> b) {
+  // Eight independent sums, so that the compiler vectorises the loop.
+  float sums[8] = {};
+  const size_t n = a.size(), whole = n / 8 * 8;
+  for (size_t i = 0; i < whole; i += 8) {
+    for (size_t j = 0; j < 8; ++j) {
+      const float d = a[i + j] - b[i + j];
+      sums[j] += d * d;
+    }
+  }
+  float total = ((sums[0] + sums[1]) + (sums[2] + sums[3])) + ((sums[4] + sums[5]) + (sums[6] + sums[7]));
+  for (size_t i = whole; i < n; ++i) total += (a[i] - b[i]) * (a[i] - b[i]);
+  return total;
+}
+
+std::vector<std::pair<float, uint32_t>> SmallestK(std::vector<std::pair<float, uint32_t>> scored, int k) {
+  const size_t keep = std::min<size_t>(k, scored.size());
+  std::partial_sort(scored.begin(), scored.begin() + keep, scored.end());
+  scored.resize(keep);
+  return scored;
+}
+
+std::vector<std::pair<float, uint32_t>> ExactIndex::SearchRows(std::span<const float> query, int k) const {
+  const DescriptorMatrix& base = set().descriptors;
+  std::vector<std::pair<float, uint32_t>> scored(base.rows());
+  for (size_t r = 0; r < base.rows(); ++r) scored[r] = {SquaredDistance(query, base.Row(r)), static_cast<uint32_t>(r)};
+  return SmallestK(std::move(scored), k);
+}
+
+}  // namespace nphand

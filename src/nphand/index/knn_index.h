@@ -1,0 +1,96 @@
+// The index stage: the K nearest database entries of a descriptor (paper Sec. 5.1). One
+// small interface, KnnIndex, with ExactIndex as its exact twin (the ground truth of every
+// recall figure); the approximate backends implement the same interface. Third-party
+// types stay in the backends' .cc files.
+//
+// Index file, version 1 (little-endian): "NPHANDIX" | u32 version | u32 meta length M | M
+// bytes of JSON meta (backend, parameters, descriptor config, the checksum and size of the
+// database it was built from) | u64 body length B | B bytes of the backend's body | u32
+// CRC-32 of everything before it. Written atomically; a corrupt, truncated, foreign or
+// other-version file, or one built from another database, is refused by name.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nphand/db/database.h"
+#include "nphand/features/descriptor.h"
+#include "nphand/util/ids.h"
+
+namespace nphand {
+
+inline constexpr uint32_t kIndexVersion = 1;
+
+// What an index searches: descriptors, one row per database entry with a hand, and the
+// entry id of each row.
+struct IndexedSet {
+  DescriptorMatrix descriptors;
+  std::vector<entry_id_t> ids;
+};
+// The stored descriptors of every entry of `db` that shows a hand (one contiguous copy).
+IndexedSet DatabaseDescriptors(const Database& db);
+
+struct Neighbours {
+  std::vector<entry_id_t> ids;   // nearest first
+  std::vector<float> distances;  // squared L2, ascending
+};
+
+class KnnIndex {
+ public:
+  virtual ~KnnIndex() = default;
+  KnnIndex(const KnnIndex&) = delete;
+  KnnIndex& operator=(const KnnIndex&) = delete;
+
+  // "exact", "lsh", "faiss-hnsw", ...
+  virtual std::string Backend() const = 0;
+  // The backend's parameters, as written in the index file.
+  virtual nlohmann::json Parameters() const = 0;
+
+  const DescriptorConfig& config() const { return set_.descriptors.config(); }
+  size_t size() const { return set_.ids.size(); }
+  // The k nearest entries of `query` (all of them when the index holds fewer). Throws
+  // nphand::Error, naming both configs, when the query was described differently.
+  Neighbours Search(const Descriptor& query, int k) const;
+  // Search for every row of `queries`, on `threads` threads (0: all cores); equal to one
+  // Search per row.
+  std::vector<Neighbours> SearchBatch(const DescriptorMatrix& queries, int k, int threads = 1) const;
+  // Backend, parameters, entries, descriptor: for `nphand index info`.
+  nlohmann::json Describe() const;
+
+  // Writes the index file (atomically) for the database it was built from.
+  void Save(const std::filesystem::path& path, const Database& db) const;
+
+ protected:
+  explicit KnnIndex(IndexedSet set) : set_(std::move(set)) {}
+  const IndexedSet& set() const { return set_; }
+  // The k nearest rows of the set: (squared distance, row), ascending, ties by row.
+  virtual std::vector<std::pair<float, uint32_t>> SearchRows(std::span<const float> query, int k) const = 0;
+  // What the backend needs, beyond the set, to be loaded again.
+  virtual std::vector<uint8_t> Body() const = 0;
+
+ private:
+  IndexedSet set_;
+};
+
+// Backend options, for BuildIndex and `nphand index build`.
+struct IndexOptions {
+  std::string backend = "exact";  // exact (more come with the approximate backends)
+  bool Check(std::string* why) const;
+};
+
+// Builds an index of every entry of `db` that shows a hand.
+std::unique_ptr<KnnIndex> BuildIndex(const Database& db, const IndexOptions& options);
+// Loads an index file for `db`; throws nphand::Error naming the file and the problem (not an
+// index, another version, corrupt, truncated, built from another database or descriptor).
+std::unique_ptr<KnnIndex> LoadIndex(const std::filesystem::path& path, const Database& db);
+// The meta of an index file (checked as LoadIndex does, without a database).
+nlohmann::json ReadIndexMeta(const std::filesystem::path& path);
+
+}  // namespace nphand
