@@ -3,14 +3,16 @@
 # real small files and the corpus kept from earlier runs (.cache/fuzz/), and prints a line
 # per target: executions, corpus size, crashes. Exits non-zero if any target crashed (the
 # input is kept in .cache/fuzz/crashes/ and belongs in a regression test).
-# Usage: scripts/fuzz.sh [--seconds N]   (default 60 per target)
+# Usage: scripts/fuzz.sh [--seconds N] [--target NAME]   (default: 60 s for each target)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds=60
+targets=(db_file db_content db_resume glb index)
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
-    *) echo "usage: scripts/fuzz.sh [--seconds N]" >&2; exit 2 ;;
+    --target) targets=("$2"); shift 2 ;;
+    *) echo "usage: scripts/fuzz.sh [--seconds N] [--target NAME]" >&2; exit 2 ;;
   esac
 done
 
@@ -26,7 +28,6 @@ else
 fi
 
 build="$root/build-fuzz"
-targets=(db_file db_content db_resume glb)
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DNPHAND_FUZZ=ON -DNPHAND_BUILD_TESTS=OFF -DNPHAND_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" --parallel "$(nproc)" --target nphand "${targets[@]/#/fuzz_}"
@@ -42,7 +43,7 @@ export ASAN_OPTIONS="detect_leaks=1"
 python3 - "$seeds" <<'PY'
 import os, struct, sys, zlib
 seeds = sys.argv[1]
-for t in ("db_file", "db_content", "db_resume"):
+for t in ("db_file", "db_content", "db_resume", "glb", "index"):
     os.makedirs(os.path.join(seeds, t), exist_ok=True)
 for name in ("tiny", "shard"):
     data = open(os.path.join(seeds, name + ".db"), "rb").read()
@@ -63,8 +64,9 @@ for name in ("tiny", "shard"):
             open(os.path.join(seeds, "db_resume", "kept%d" % kept), "wb").write(
                 struct.pack("<I", len(partial)) + partial + blocks)
 PY
-mkdir -p "$seeds/glb"
 cp "$root/.cache/hand/right.glb" "$root/.cache/hand/left.glb" "$seeds/glb/"
+"$build/apps/nphand" index build --db "$seeds/tiny.db" --out "$seeds/index/tiny.idx" >/dev/null
+export NPHAND_FUZZ_DB="$seeds/tiny.db"  # the database the index target loads its inputs against
 
 failed=0
 for t in "${targets[@]}"; do
