@@ -1,6 +1,7 @@
 #include "apps/index_command.h"
 
 #include <chrono>
+#include <iostream>
 
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
@@ -14,7 +15,7 @@ nlohmann::json RunIndexBuild(const IndexBuildCommandOptions& options) {
   CheckOutputFile(out, "index build --out");
   const auto start = std::chrono::steady_clock::now();
   const Database db = Database::Open(options.db);
-  const std::unique_ptr<KnnIndex> index = BuildIndex(db, options.index);
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db, options.index, &std::cerr);
   index->Save(out, db);
   nlohmann::json summary = index->Describe();
   summary["path"] = out.string();

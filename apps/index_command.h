@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "nphand/index/knn_index.h"
+#include "nphand/index/backends.h"
 
 namespace nphand {
 

@@ -133,7 +133,18 @@ void AddIndexCommand(CLI::App& app, IndexArgs& a) {
   index->require_subcommand(1);
   CLI::App* build = index->add_subcommand("build", "Index every database entry with a hand for K-nearest search");
   build->add_option("--db", a.build.db, "Database file")->capture_default_str();
-  build->add_option("--backend", a.build.index.backend, "exact")->capture_default_str();
+  build->add_option("--backend", a.build.index.backend, "exact or lsh")->capture_default_str();
+  nphand::LshOptions& lsh = a.build.index.lsh;
+  build->add_option("--lsh-tables", lsh.tables, "LSH: hash tables (L)")->capture_default_str();
+  build->add_option("--lsh-probes", lsh.probes, "LSH: buckets probed per table (T)")->capture_default_str();
+  build->add_option("--lsh-hashes", lsh.hashes, "LSH: hashes per table (M; 0: tuned)")->capture_default_str();
+  build->add_option("--lsh-width", lsh.bucket_width, "LSH: bucket width (W; 0: tuned)")->capture_default_str();
+  build->add_option("--lsh-recall", lsh.target_recall, "LSH: the recall of the true K nearest to tune for (R)")
+      ->capture_default_str();
+  build->add_option("--lsh-k", lsh.tune_k, "LSH: the K whose recall is tuned")->capture_default_str();
+  build->add_option("--lsh-queries", lsh.tune_queries, "LSH: sampled queries the tuner measures on")
+      ->capture_default_str();
+  build->add_option("--seed", lsh.seed, "LSH: seed of the projections and the tuner's sample")->capture_default_str();
   build->add_option("--out", a.build.out, "Index file to write (default: the database's path + .idx)");
   build->add_flag("--json", a.json, "Print one JSON object");
   build->callback([&a]() { PrintJson(nphand::RunIndexBuild(a.build), a.json); });

@@ -1,7 +1,5 @@
 #include "nphand/eval/feature_study.h"
 
-#include <unistd.h>
-
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -13,17 +11,8 @@
 namespace nphand {
 namespace {
 
-class FeatureStudyTest : public ::testing::Test {
+class FeatureStudyTest : public testing::TinyDatabaseTest {
  protected:
-  static std::filesystem::path Path() {
-    return std::filesystem::temp_directory_path() / ("nphand_feature_study_" + std::to_string(::getpid()) + ".db");
-  }
-  static void SetUpTestSuite() { db_ = new Database(Database::Open(testing::BuildTinyDatabase(Path()))); }
-  static void TearDownTestSuite() {
-    delete db_;
-    db_ = nullptr;
-    std::filesystem::remove(Path());
-  }
   static FeatureStudyOptions Options() {
     FeatureStudyOptions options;
     options.queries = 40;
@@ -31,12 +20,10 @@ class FeatureStudyTest : public ::testing::Test {
     options.features = {"joints", "hog8x8x8", "dist32", "chamfer_rerank"};
     return options;
   }
-  static Database* db_;
 };
-Database* FeatureStudyTest::db_ = nullptr;
 
 TEST_F(FeatureStudyTest, CurvesHaveOneValuePerNeighbourAndAreDeterministic) {
-  const FeatureStudyResult a = RunFeatureStudy(*db_, Options(), nullptr);
+  const FeatureStudyResult a = RunFeatureStudy(db(), Options(), nullptr);
   ASSERT_EQ(a.curves.size(), 4u);
   for (const FeatureCurve& c : a.curves) {
     ASSERT_EQ(c.joint_deg.size(), 10u);
@@ -47,19 +34,19 @@ TEST_F(FeatureStudyTest, CurvesHaveOneValuePerNeighbourAndAreDeterministic) {
   }
   EXPECT_EQ(a.curves[1].dimension, 512);
   EXPECT_EQ(a.curves[2].dimension, 1024);
-  const FeatureStudyResult b = RunFeatureStudy(*db_, Options(), nullptr);
+  const FeatureStudyResult b = RunFeatureStudy(db(), Options(), nullptr);
   EXPECT_EQ(a.curves[1].joint_deg, b.curves[1].joint_deg);
 }
 
 TEST_F(FeatureStudyTest, QueryAndItsTwinAreLeftOut) {
   // Every entry has a twin with the same pose (with/without the object): were it not left
   // out, pose-space neighbour 1 would always be exact.
-  const FeatureStudyResult result = RunFeatureStudy(*db_, Options(), nullptr);
+  const FeatureStudyResult result = RunFeatureStudy(db(), Options(), nullptr);
   EXPECT_GT(result.curves[0].joint_deg[0] + result.curves[0].wrist_deg[0], 0.1);
 }
 
 TEST_F(FeatureStudyTest, PoseSpaceBoundsTheWristErrorOfFeatures) {
-  const FeatureStudyResult result = RunFeatureStudy(*db_, Options(), nullptr);
+  const FeatureStudyResult result = RunFeatureStudy(db(), Options(), nullptr);
   EXPECT_LE(result.curves[0].wrist_deg[0], result.curves[1].wrist_deg[0]);
 }
 
@@ -67,15 +54,15 @@ TEST_F(FeatureStudyTest, RollNormalisationMakesRolledQueriesFindTheirPose) {
   FeatureStudyOptions options = Options();
   options.features = {"hog8x8x8"};
   options.roll_queries = true;
-  const double rolled = RunFeatureStudy(*db_, options, nullptr).curves[0].wrist_deg[0];
+  const double rolled = RunFeatureStudy(db(), options, nullptr).curves[0].wrist_deg[0];
   options.normalize_roll = true;
-  const double normalized = RunFeatureStudy(*db_, options, nullptr).curves[0].wrist_deg[0];
+  const double normalized = RunFeatureStudy(db(), options, nullptr).curves[0].wrist_deg[0];
   // Unnormalised HOG cannot match a turned hand; normalised it recovers the roll.
   EXPECT_LT(normalized, 0.6 * rolled) << "rolled " << rolled << ", normalised " << normalized;
 }
 
 TEST_F(FeatureStudyTest, OutputsDescribeTheResult) {
-  const FeatureStudyResult result = RunFeatureStudy(*db_, Options(), nullptr);
+  const FeatureStudyResult result = RunFeatureStudy(db(), Options(), nullptr);
   const nlohmann::json json = ToJson(result);
   EXPECT_EQ(json["curves"].size(), 4u);
   EXPECT_EQ(json["curves"][1]["paper_joint_deg"][0], 1.32);
@@ -90,12 +77,12 @@ TEST_F(FeatureStudyTest, OutputsDescribeTheResult) {
 TEST_F(FeatureStudyTest, BadOptionsAreRefused) {
   FeatureStudyOptions options = Options();
   options.features = {"sift"};
-  EXPECT_THROW(RunFeatureStudy(*db_, options, nullptr), Error);
+  EXPECT_THROW(RunFeatureStudy(db(), options, nullptr), Error);
   // More queries than entries used to be reported as asked, not as run.
   options = Options();
   options.queries = 99999999;
   try {
-    RunFeatureStudy(*db_, options, nullptr);
+    RunFeatureStudy(db(), options, nullptr);
     ADD_FAILURE() << "ran 99999999 queries on 160 entries";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("only"), std::string::npos) << e.what();
@@ -107,9 +94,9 @@ TEST_F(FeatureStudyTest, BadOptionsAreRefused) {
 TEST_F(FeatureStudyTest, ChunkedSearchEqualsOneSearch) {
   FeatureStudyOptions options = Options();
   options.normalize_roll = true;
-  const FeatureStudyResult whole = RunFeatureStudy(*db_, options, nullptr);
+  const FeatureStudyResult whole = RunFeatureStudy(db(), options, nullptr);
   options.chunk = 7;
-  const FeatureStudyResult chunked = RunFeatureStudy(*db_, options, nullptr);
+  const FeatureStudyResult chunked = RunFeatureStudy(db(), options, nullptr);
   for (size_t f = 0; f < whole.curves.size(); ++f) {
     for (size_t i = 0; i < whole.curves[f].joint_deg.size(); ++i) {
       EXPECT_NEAR(whole.curves[f].joint_deg[i], chunked.curves[f].joint_deg[i], 1e-9) << whole.curves[f].name;

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <memory>
 
-#include "nphand/index/knn_index.h"
+#include "nphand/index/backends.h"
 #include "nphand/util/check.h"
 #include "tests/fuzz/fuzz_support.h"
 

@@ -1,6 +1,4 @@
-#include "nphand/index/knn_index.h"
-
-#include <unistd.h>
+#include "nphand/index/backends.h"
 
 #include <gtest/gtest.h>
 
@@ -13,29 +11,14 @@
 namespace nphand {
 namespace {
 
-class KnnIndexTest : public ::testing::Test {
+class KnnIndexTest : public testing::TinyDatabaseTest {
  protected:
-  static std::filesystem::path Path() {
-    return std::filesystem::temp_directory_path() / ("nphand_knn_index_" + std::to_string(::getpid()) + ".db");
-  }
-  static void SetUpTestSuite() { db_ = new Database(Database::Open(testing::BuildTinyDatabase(Path()))); }
-  static void TearDownTestSuite() {
-    delete db_;
-    db_ = nullptr;
-    std::filesystem::remove(Path());
-  }
-  // Entry `i`'s stored descriptor as a query.
-  static Descriptor QueryOf(size_t i) {
-    return {db_->descriptor(), std::vector<float>(db_->Hog(i).begin(), db_->Hog(i).end()), 0.0};
-  }
-  static Database* db_;
 };
-Database* KnnIndexTest::db_ = nullptr;
 
 TEST_F(KnnIndexTest, ExactSearchReturnsTheTrueNearestInOrder) {
-  const std::unique_ptr<KnnIndex> index = BuildIndex(*db_, {});
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), {});
   EXPECT_EQ(index->Backend(), "exact");
-  EXPECT_EQ(index->size(), DatabaseDescriptors(*db_).ids.size());
+  EXPECT_EQ(index->size(), DatabaseDescriptors(db()).ids.size());
   for (size_t q : {size_t{3}, size_t{77}, size_t{150}}) {
     const Neighbours found = index->Search(QueryOf(q), 10);
     ASSERT_EQ(found.ids.size(), 10u);
@@ -43,8 +26,8 @@ TEST_F(KnnIndexTest, ExactSearchReturnsTheTrueNearestInOrder) {
     EXPECT_EQ(found.distances[0], 0.0f);
     // Brute force over every entry with a hand.
     std::vector<std::pair<float, entry_id_t>> all;
-    for (size_t i = 0; i < db_->size(); ++i) {
-      if (db_->Meta(i).has_hand) all.emplace_back(SquaredDistance(db_->Hog(q), db_->Hog(i)), i);
+    for (size_t i = 0; i < db().size(); ++i) {
+      if (db().Meta(i).has_hand) all.emplace_back(SquaredDistance(db().Hog(q), db().Hog(i)), i);
     }
     std::sort(all.begin(), all.end());
     for (int r = 0; r < 10; ++r) {
@@ -56,10 +39,10 @@ TEST_F(KnnIndexTest, ExactSearchReturnsTheTrueNearestInOrder) {
 }
 
 TEST_F(KnnIndexTest, BatchSearchEqualsOneAtATime) {
-  const std::unique_ptr<KnnIndex> index = BuildIndex(*db_, {});
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), {});
   std::vector<float> values;
-  for (size_t q = 0; q < 20; ++q) values.insert(values.end(), db_->Hog(q * 7).begin(), db_->Hog(q * 7).end());
-  const DescriptorMatrix queries(db_->descriptor(), values);
+  for (size_t q = 0; q < 20; ++q) values.insert(values.end(), db().Hog(q * 7).begin(), db().Hog(q * 7).end());
+  const DescriptorMatrix queries(db().descriptor(), values);
   const std::vector<Neighbours> batch = index->SearchBatch(queries, 5, 2);
   for (size_t q = 0; q < 20; ++q) {
     const Neighbours one = index->Search(QueryOf(q * 7), 5);
@@ -69,7 +52,7 @@ TEST_F(KnnIndexTest, BatchSearchEqualsOneAtATime) {
 }
 
 TEST_F(KnnIndexTest, QueryDescribedDifferentlyIsRefusedNamingBoth) {
-  const std::unique_ptr<KnnIndex> index = BuildIndex(*db_, {});
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), {});
   Descriptor query = QueryOf(3);
   query.config.normalize_roll = false;
   testing::ExpectError([&] { index->Search(query, 5); },
@@ -80,11 +63,11 @@ TEST_F(KnnIndexTest, QueryDescribedDifferentlyIsRefusedNamingBoth) {
 
 TEST_F(KnnIndexTest, SavedIndexLoadsForItsDatabaseOnly) {
   const auto dir = testing::ScratchDir();
-  const std::unique_ptr<KnnIndex> index = BuildIndex(*db_, {});
-  index->Save(dir / "tiny.idx", *db_);
-  const std::unique_ptr<KnnIndex> loaded = LoadIndex(dir / "tiny.idx", *db_);
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), {});
+  index->Save(dir / "tiny.idx", db());
+  const std::unique_ptr<KnnIndex> loaded = LoadIndex(dir / "tiny.idx", db());
   EXPECT_EQ(loaded->Search(QueryOf(9), 7).ids, index->Search(QueryOf(9), 7).ids);
-  EXPECT_EQ(ReadIndexMeta(dir / "tiny.idx")["database"]["checksum"], db_->checksum());
+  EXPECT_EQ(ReadIndexMeta(dir / "tiny.idx")["database"]["checksum"], db().checksum());
 
   DatabaseBuildOptions other = testing::TinyDatabaseOptions();
   other.directions = 6;
@@ -95,27 +78,27 @@ TEST_F(KnnIndexTest, SavedIndexLoadsForItsDatabaseOnly) {
 
 TEST_F(KnnIndexTest, CorruptTruncatedForeignAndFutureIndexFilesAreRefusedByName) {
   const auto dir = testing::ScratchDir();
-  BuildIndex(*db_, {})->Save(dir / "good.idx", *db_);
+  BuildIndex(db(), {})->Save(dir / "good.idx", db());
   const std::vector<uint8_t> good = ReadFileBytes(dir / "good.idx");
   for (size_t i = 0; i < good.size(); ++i) {
     std::vector<uint8_t> bad = good;
     bad[i] ^= 0x20;
     WriteFileAtomic(dir / "bad.idx", bad);
-    testing::ExpectError([&] { LoadIndex(dir / "bad.idx", *db_); }, "bad.idx: ");
+    testing::ExpectError([&] { LoadIndex(dir / "bad.idx", db()); }, "bad.idx: ");
   }
   for (size_t length : {size_t{0}, size_t{7}, size_t{15}, good.size() / 2, good.size() - 1}) {
     WriteFileAtomic(dir / "cut.idx", std::span<const uint8_t>(good.data(), length));
-    testing::ExpectError([&] { LoadIndex(dir / "cut.idx", *db_); }, "cut.idx: ");
+    testing::ExpectError([&] { LoadIndex(dir / "cut.idx", db()); }, "cut.idx: ");
   }
   std::vector<uint8_t> longer = good;
   longer.push_back(0);
   WriteFileAtomic(dir / "long.idx", longer);
-  testing::ExpectError([&] { LoadIndex(dir / "long.idx", *db_); }, "long.idx: 1 bytes after the end");
+  testing::ExpectError([&] { LoadIndex(dir / "long.idx", db()); }, "long.idx: 1 bytes after the end");
   std::vector<uint8_t> future = good;
   future[8] = 2;
   WriteFileAtomic(dir / "future.idx", future);
-  testing::ExpectError([&] { LoadIndex(dir / "future.idx", *db_); }, "future.idx: index format version 2");
-  testing::ExpectError([&] { LoadIndex(Path(), *db_); }, "not an nphand index");
+  testing::ExpectError([&] { LoadIndex(dir / "future.idx", db()); }, "future.idx: index format version 2");
+  testing::ExpectError([&] { LoadIndex(Path(), db()); }, "not an nphand index");
 }
 
 }  // namespace

@@ -9,11 +9,12 @@
 #include <set>
 
 #include <sys/mman.h>
-#include <zlib.h>
+#include <zlib.h>  // crc32_combine
 
 #include "nphand/features/hog.h"
 #include "nphand/scene/grasp.h"
 #include "nphand/util/check.h"
+#include "nphand/util/io.h"
 
 namespace nphand {
 namespace {
@@ -23,16 +24,6 @@ constexpr char kFooterMagic[8] = {'N', 'P', 'H', 'E', 'N', 'D', 0, 0};
 constexpr size_t kFooterBytes = 8 + 8 + 4;
 constexpr size_t kAlignment = 64;
 constexpr uint32_t kMaxHeaderBytes = 16u << 20;
-
-uint32_t Crc(uint32_t crc, const uint8_t* data, size_t size) {
-  while (size > 0) {
-    const uInt chunk = static_cast<uInt>(std::min<size_t>(size, 1u << 30));
-    crc = static_cast<uint32_t>(crc32(crc, data, chunk));
-    data += chunk;
-    size -= chunk;
-  }
-  return crc;
-}
 
 template <typename T>
 void Put(std::vector<uint8_t>* out, T value) {
@@ -54,7 +45,7 @@ std::vector<uint8_t> Prologue(const nlohmann::json& header) {
   Put<uint32_t>(&out, kDatabaseVersion);
   Put<uint32_t>(&out, static_cast<uint32_t>(text.size()));
   out.insert(out.end(), text.begin(), text.end());
-  Put<uint32_t>(&out, Crc(0, reinterpret_cast<const uint8_t*>(text.data()), text.size()));
+  Put<uint32_t>(&out, Crc32(0, {reinterpret_cast<const uint8_t*>(text.data()), text.size()}));
   out.resize((out.size() + kAlignment - 1) / kAlignment * kAlignment, 0);
   return out;
 }
@@ -190,7 +181,7 @@ std::pair<nlohmann::json, size_t> ReadPrologue(const uint8_t* bytes, size_t size
   NPHAND_THROW_CHECK(header_bytes <= kMaxHeaderBytes && 16 + size_t{header_bytes} + 4 <= size, source,
                      ": truncated header");
   const uint8_t* text = bytes + 16;
-  NPHAND_THROW_CHECK(Get<uint32_t>(text + header_bytes) == Crc(0, text, header_bytes), source,
+  NPHAND_THROW_CHECK(Get<uint32_t>(text + header_bytes) == Crc32(0, std::span<const uint8_t>(text, header_bytes)), source,
                      ": checksum mismatch in the header");
   nlohmann::json header = nlohmann::json::parse(text, text + header_bytes, nullptr, false);
   NPHAND_THROW_CHECK(!header.is_discarded(), source, ": the header is not valid JSON");
@@ -374,12 +365,12 @@ void DatabaseWriter::Resume() {
     const uint64_t offset = prologue_.size() + count_ * record_bytes_;
     if (records == 0 || records > expected_ - count_ || records * record_bytes_ > size - offset) break;
     block.resize(records * record_bytes_);
-    if (!file_.ReadAt(offset, block) || Crc(0, block.data(), block.size()) != Get<uint32_t>(entry.data() + 8)) {
+    if (!file_.ReadAt(offset, block) || Crc32(0, block) != Get<uint32_t>(entry.data() + 8)) {
       note_ = partial + ": records " + std::to_string(count_) + " to " + std::to_string(count_ + records - 1) +
               " fail their checksum; building again from record " + std::to_string(count_);
       break;
     }
-    crc_ = Crc(crc_, block.data(), block.size());
+    crc_ = Crc32(crc_, block);
     count_ += records;
     ++kept_blocks;
   }
@@ -397,7 +388,7 @@ void DatabaseWriter::Append(std::span<const uint8_t> records) {
   NPHAND_THROW_CHECK(count_ + count <= expected_, file_.path().string(), ": ", count_ + count,
                      " records would exceed the header's ", expected_);
   file_.WriteAt(prologue_.size() + count_ * record_bytes_, records);
-  const uint32_t block_crc = Crc(0, records.data(), records.size());
+  const uint32_t block_crc = Crc32(0, records);
   std::vector<uint8_t> entry;
   Put<uint64_t>(&entry, count);
   Put<uint32_t>(&entry, block_crc);
@@ -472,7 +463,7 @@ Database Database::Open(const std::filesystem::path& path, bool verify_records) 
     std::optional<Error> impossible;
     for (size_t begin = 0; begin < count; begin += kBlock) {
       const size_t end = std::min<size_t>(count, begin + kBlock);
-      crc = Crc(crc, db.records_ + begin * record_bytes, (end - begin) * record_bytes);
+      crc = Crc32(crc, {db.records_ + begin * record_bytes, (end - begin) * record_bytes});
       if (impossible) continue;
       try {
         db.VerifyRecords(begin, end);

@@ -79,18 +79,4 @@ class KnnIndex {
   IndexedSet set_;
 };
 
-// Backend options, for BuildIndex and `nphand index build`.
-struct IndexOptions {
-  std::string backend = "exact";  // exact (more come with the approximate backends)
-  bool Check(std::string* why) const;
-};
-
-// Builds an index of every entry of `db` that shows a hand.
-std::unique_ptr<KnnIndex> BuildIndex(const Database& db, const IndexOptions& options);
-// Loads an index file for `db`; throws nphand::Error naming the file and the problem (not an
-// index, another version, corrupt, truncated, built from another database or descriptor).
-std::unique_ptr<KnnIndex> LoadIndex(const std::filesystem::path& path, const Database& db);
-// The meta of an index file (checked as LoadIndex does, without a database).
-nlohmann::json ReadIndexMeta(const std::filesystem::path& path);
-
 }  // namespace nphand

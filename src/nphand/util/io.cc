@@ -1,7 +1,9 @@
 #include "nphand/util/io.h"
 
 #include <openssl/evp.h>
+#include <zlib.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -54,6 +56,18 @@ void WriteFileAtomic(const std::filesystem::path& path, std::span<const uint8_t>
 
 void WriteFileAtomic(const std::filesystem::path& path, const std::string& text) {
   WriteFileAtomic(path, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
+}
+
+uint32_t Crc32(uint32_t crc, std::span<const uint8_t> bytes) {
+  const uint8_t* data = bytes.data();
+  size_t size = bytes.size();
+  while (size > 0) {
+    const uInt chunk = static_cast<uInt>(std::min<size_t>(size, 1u << 30));
+    crc = static_cast<uint32_t>(crc32(crc, data, chunk));
+    data += chunk;
+    size -= chunk;
+  }
+  return crc;
 }
 
 std::string Sha256Hex(std::span<const uint8_t> bytes) {

@@ -18,6 +18,9 @@ std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path);
 void WriteFileAtomic(const std::filesystem::path& path, std::span<const uint8_t> bytes);
 void WriteFileAtomic(const std::filesystem::path& path, const std::string& text);
 
+// CRC-32 (zlib's) of `bytes`, continuing `crc` (0 to start); any size.
+uint32_t Crc32(uint32_t crc, std::span<const uint8_t> bytes);
+
 // Lower-case hex SHA-256 of `bytes`.
 std::string Sha256Hex(std::span<const uint8_t> bytes);
 
