@@ -1,5 +1,7 @@
 #include "nphand/index/backends.h"
 
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include "nphand/index/exact_index.h"
@@ -59,6 +61,9 @@ TEST_F(KnnIndexTest, QueryDescribedDifferentlyIsRefusedNamingBoth) {
                        "the query: described as hog8x8x8, crop 64 px + 0.1 margin, roll as seen, but hog8x8x8, crop "
                        "64 px + 0.1 margin, roll-normalised is expected");
   testing::ExpectError([&] { index->Search(QueryOf(3), 0); }, "k must be at least 1");
+  Descriptor broken = QueryOf(3);
+  broken.values[100] = std::numeric_limits<float>::quiet_NaN();
+  testing::ExpectError([&] { index->Search(broken, 5); }, "not a finite number");
 }
 
 TEST_F(KnnIndexTest, SavedIndexLoadsForItsDatabaseOnly) {

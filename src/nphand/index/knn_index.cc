@@ -1,5 +1,8 @@
 #include "nphand/index/knn_index.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "nphand/index/index_file.h"
 #include "nphand/util/check.h"
 #include "nphand/util/parallel.h"
@@ -24,6 +27,8 @@ Neighbours KnnIndex::Search(const Descriptor& query, int k) const {
   NPHAND_THROW_CHECK(k >= 1, "search: k must be at least 1, not ", k);
   NPHAND_THROW_CHECK(query.values.size() == static_cast<size_t>(config().Dimension()), "search: the query has ",
                      query.values.size(), " values, the index ", config().Dimension());
+  NPHAND_THROW_CHECK(std::all_of(query.values.begin(), query.values.end(), [](float v) { return std::isfinite(v); }),
+                     "search: the query has a value that is not a finite number");
   Neighbours neighbours;
   for (const auto& [distance, row] : SearchRows(query.values, k)) {
     neighbours.ids.push_back(set_.ids[row]);

@@ -31,6 +31,10 @@ uint64_t KeyOf(const int32_t* hashes, int m) {
   return key;
 }
 
+// The hash value of a scaled projection plus offset: floor, kept within int32 whatever the
+// input (a tiny W or an extreme descriptor must not overflow the conversion).
+int32_t HashOf(float f) { return static_cast<int32_t>(std::floor(std::clamp(f, -2.0e9f, 2.0e9f))); }
+
 // A perturbation set of the probing sequence: indices into the sorted boundaries.
 struct Perturbation {
   float score = 0.0f;
@@ -93,9 +97,9 @@ bool LshOptions::Check(std::string* why) const {
     *why = "LSH needs 1 to 64 tables and 1 to 10000 probes per table";
     return false;
   }
-  if (hashes < 0 || hashes > kMaxLshHashes || !(bucket_width >= 0.0 && bucket_width < 1e6)) {
+  if (hashes < 0 || hashes > kMaxLshHashes || !(bucket_width == 0.0 || (bucket_width >= 1e-6 && bucket_width <= 1e6))) {
     *why = "LSH hashes per table must be 0 (tuned) to " + std::to_string(kMaxLshHashes) +
-           " and the bucket width 0 (tuned) or positive";
+           " and the bucket width 0 (tuned) or within [1e-6, 1e6]";
     return false;
   }
   if (!(target_recall > 0.0 && target_recall <= 1.0) || tune_k < 1 || tune_queries < 1) {
@@ -109,6 +113,7 @@ LshIndex::LshIndex(IndexedSet set, const LshOptions& options, std::ostream* prog
     : KnnIndex(std::move(set)), options_(options) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "lsh: ", why);
+  NPHAND_THROW_CHECK(!this->set().ids.empty(), "lsh: the database has no entry with a hand to index");
   NPHAND_THROW_CHECK(this->set().ids.size() < (1ull << 32), "lsh: too many rows");
   const int dimension = config().Dimension();
   const int columns = options_.tables * kMaxLshHashes;
@@ -140,7 +145,7 @@ std::vector<LshIndex::Table> LshIndex::BuildTables(const std::vector<float>& pro
     for (size_t r = 0; r < rows; ++r) {
       const float* p = projected.data() + r * columns + t * kMaxLshHashes;
       for (int j = 0; j < m; ++j) {
-        hashes[j] = static_cast<int32_t>(std::floor(p[j] * inverse_width + offsets_[t * kMaxLshHashes + j]));
+        hashes[j] = HashOf(p[j] * inverse_width + offsets_[t * kMaxLshHashes + j]);
       }
       keyed[r] = {KeyOf(hashes.data(), m), static_cast<uint32_t>(r)};
     }
@@ -163,8 +168,8 @@ std::vector<uint32_t> LshIndex::Candidates(const std::vector<Table>& tables, std
   for (int t = 0; t < options_.tables; ++t) {
     for (int j = 0; j < m; ++j) {
       const float f = projected[t * kMaxLshHashes + j] * inverse_width + offsets_[t * kMaxLshHashes + j];
-      home[j] = static_cast<int32_t>(std::floor(f));
-      fraction[j] = f - std::floor(f);
+      home[j] = HashOf(f);
+      fraction[j] = std::clamp(f - std::floor(f), 0.0f, 1.0f);
     }
     const auto visit = [&](const std::vector<int32_t>& hashes) {
       const uint64_t key = KeyOf(hashes.data(), m);
