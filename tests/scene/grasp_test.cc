@@ -3,6 +3,8 @@
 #include <cmath>
 #include <set>
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "nphand/util/check.h"
@@ -58,6 +60,21 @@ TEST_P(GraspConsistencyTest, ContactsTouchAndNothingPenetrates) {
 
 INSTANTIATE_TEST_SUITE_P(AllGrasps, GraspConsistencyTest, ::testing::Range(0, kNumGrasps),
                          [](const ::testing::TestParamInfo<int>& info) { return GraspKey(GraspTaxonomy()[info.param]); });
+
+// A grasp definition is data a library user may write: impossible ones are errors, not aborts.
+TEST(GraspTest, ImpossibleDefinitionsAreRefusedWithTheirName) {
+  const auto opposed = std::find_if(GraspTaxonomy().begin(), GraspTaxonomy().end(),
+                                    [](const GraspDefinition& g) { return g.oppose_thumb; });
+  ASSERT_NE(opposed, GraspTaxonomy().end());
+  GraspDefinition thumb_only = *opposed;
+  thumb_only.name = "Thumb Only";
+  thumb_only.contacts = {Digit::kThumb};
+  testing::ExpectError([&] { MakeGrasp(RightHand(), thumb_only); }, "grasp Thumb Only: needs a contact finger");
+  GraspDefinition huge = GraspTaxonomy()[0];
+  huge.name = "Huge";
+  huge.object.size[0] = 0.5;  // a cylinder half a metre in radius never clears the hand
+  testing::ExpectError([&] { MakeGrasp(RightHand(), huge); }, "grasp Huge: the object cannot be moved clear");
+}
 
 TEST(GraspTest, MakeGraspIsDeterministic) {
   const Grasp a = MakeGrasp(RightHand(), GraspTaxonomy()[0]), b = MakeGrasp(RightHand(), GraspTaxonomy()[0]);

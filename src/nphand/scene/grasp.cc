@@ -64,7 +64,7 @@ Eigen::Vector3d FingertipCentroid(const GraspDefinition& g, const JointPositions
     tips += joints[Index(kDigitTip[DigitIndex(d)])];
     ++fingers;
   }
-  NPHAND_CHECK(fingers > 0, g.name, ": needs a contact finger");
+  NPHAND_THROW_CHECK(fingers > 0, "grasp ", g.name, ": needs a contact finger");
   return tips / fingers;
 }
 
@@ -102,7 +102,7 @@ Eigen::Vector3d AnchorPoint(const GraspDefinition& g, const JointPositions& p) {
       count = 1;
       break;
   }
-  NPHAND_CHECK(count > 0, g.name, ": the anchor has no landmark");
+  NPHAND_THROW_CHECK(count > 0, "grasp ", g.name, ": the anchor has no landmark");
   return sum / count + g.anchor_offset;
 }
 
@@ -115,7 +115,7 @@ Eigen::Vector3d PlaceObject(const GraspDefinition& g, const std::vector<Eigen::V
   };
   if (distance_at(0.0) >= g.gap) return anchor;
   double near = 0.0, far = 0.4;
-  NPHAND_CHECK(distance_at(far) > g.gap, g.name, ": the object cannot be moved clear of the hand");
+  NPHAND_THROW_CHECK(distance_at(far) > g.gap, "grasp ", g.name, ": the object cannot be moved clear of the hand");
   for (int i = 0; i < 40; ++i) {
     const double mid = 0.5 * (near + far);
     (distance_at(mid) >= g.gap ? far : near) = mid;
