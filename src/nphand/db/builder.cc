@@ -34,34 +34,28 @@ std::pair<uint64_t, uint64_t> ShardRange(const DatabaseBuildOptions& options) {
 struct Context {
   const HandModel& hand;
   const DatabaseBuildOptions& options;
-  std::vector<int> grasp_ids;
-  std::vector<Grasp> grasps;
+  Enumeration enumeration;
+  std::vector<Grasp> grasps;  // in the enumeration's order
   std::vector<Eigen::Vector3d> directions;
   Intrinsics intrinsics;
   RecordLayout layout;
 };
 
-// Entry `index` of the enumeration: ((grasp * steps + step) * 2 + with_object) * directions + viewpoint.
+// Entry `index` of the enumeration (see Enumeration).
 void RenderEntry(const Context& c, uint64_t index, Renderer* renderer, cv::Mat* labels, std::span<uint8_t> record,
                  uint64_t* no_hand) {
-  const uint64_t directions = c.directions.size();
-  const int view = static_cast<int>(index % directions);
-  const bool with_object = (index / directions) % 2 == 1;
-  const int step = static_cast<int>((index / directions / 2) % kGraspSteps);
-  const size_t g = index / directions / 2 / kGraspSteps;
-  const Grasp& grasp = c.grasps[g];
+  Entry entry;
+  entry.meta = c.enumeration.At(index);
+  const Grasp& grasp = c.grasps[c.enumeration.GraspPosition(index)];
 
   Scene scene;
   scene.hand.handedness = c.hand.handedness();
-  scene.hand.angles = grasp.steps[step];
-  scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(c.directions[view]));
+  scene.hand.angles = grasp.steps[entry.meta.step];
+  scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(c.directions[entry.meta.viewpoint]));
   scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, c.hand.bind_centre(), c.options.distance);
-  if (with_object) scene.objects = {grasp.object};
+  if (entry.meta.with_object) scene.objects = {grasp.object};
   renderer->RenderLabels(scene, c.intrinsics, labels);
 
-  Entry entry;
-  entry.meta = {static_cast<uint8_t>(c.grasp_ids[g]), static_cast<uint8_t>(step), with_object, false,
-                static_cast<uint16_t>(view)};
   entry.pose = ToPoseVector(scene.hand);
   entry.angles = scene.hand.angles;
   entry.keypoints = c.hand.KeypointsOf(scene.hand);
@@ -188,13 +182,14 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
   CheckOutputFile(path, "db build --out");
   const auto start = std::chrono::steady_clock::now();
 
-  Context c{hand, options, GraspsOf(options), {}, ViewSphereDirections(options.directions),
+  const nlohmann::json header = options.Header();
+  Context c{hand, options, Enumeration(header), {}, ViewSphereDirections(options.directions),
             Intrinsics::FromFieldOfView(options.image_size, options.image_size, options.fov_deg * std::numbers::pi / 180.0),
             {}};
   c.layout.hog_dimension = options.descriptor.Dimension();
-  for (int id : c.grasp_ids) c.grasps.push_back(MakeGrasp(hand, GraspTaxonomy()[id - 1]));
+  for (int id : c.enumeration.grasps) c.grasps.push_back(MakeGrasp(hand, GraspTaxonomy()[id - 1]));
 
-  DatabaseWriter writer(path, options.Header(), DatabaseWriter::Mode::kResume);
+  DatabaseWriter writer(path, header, DatabaseWriter::Mode::kResume);
   const auto [begin, end] = ShardRange(options);
   BuildSummary summary;
   summary.resumed = writer.records_written();

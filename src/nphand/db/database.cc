@@ -131,28 +131,6 @@ DescriptorConfig DescriptorOf(const nlohmann::json& header) {
   return config;
 }
 
-// Where the records of a (validated) header sit in the full enumeration.
-struct Enumeration {
-  std::vector<int> grasps;
-  uint64_t steps = 0, viewpoints = 0, begin = 0;
-
-  explicit Enumeration(const nlohmann::json& header)
-      : grasps(header["grasps"].get<std::vector<int>>()),
-        steps(header["steps"].get<uint64_t>()),
-        viewpoints(header["viewpoints"].get<uint64_t>()),
-        begin(header.contains("shard") ? header["shard"]["begin"].get<uint64_t>() : 0) {}
-  // The meta of record `i` of the file (see the header's "order").
-  EntryMeta At(uint64_t i) const {
-    const uint64_t index = begin + i;
-    EntryMeta meta;
-    meta.viewpoint = static_cast<uint16_t>(index % viewpoints);
-    meta.with_object = (index / viewpoints) % 2 == 1;
-    meta.step = static_cast<uint8_t>((index / viewpoints / 2) % steps);
-    meta.grasp = static_cast<uint8_t>(grasps[index / viewpoints / 2 / steps]);
-    return meta;
-  }
-};
-
 // Whether every float of `p` is a number in [min, max]. Written without early exits, so
 // that it vectorises.
 bool AllInRange(const uint8_t* p, size_t count, float min, float max) {
@@ -275,6 +253,23 @@ void ValidateHeader(const nlohmann::json& header, const std::string& source) {
   layout.hog_dimension = options.Dimension();
   f.Expect(f.Integer(header, "record_bytes", "record_bytes", 1, 1 << 30) == static_cast<int64_t>(layout.RecordBytes()),
            "record_bytes", "does not match the features (" + std::to_string(layout.RecordBytes()) + " bytes)");
+}
+
+Enumeration::Enumeration(const nlohmann::json& header)
+    : grasps(header["grasps"].get<std::vector<int>>()),
+      steps(header["steps"].get<uint64_t>()),
+      viewpoints(header["viewpoints"].get<uint64_t>()),
+      begin(header.contains("shard") ? header["shard"]["begin"].get<uint64_t>() : 0) {}
+
+size_t Enumeration::GraspPosition(uint64_t entry) const { return entry / viewpoints / 2 / steps; }
+
+EntryMeta Enumeration::At(uint64_t entry) const {
+  EntryMeta meta;
+  meta.viewpoint = static_cast<uint16_t>(entry % viewpoints);
+  meta.with_object = (entry / viewpoints) % 2 == 1;
+  meta.step = static_cast<uint8_t>((entry / viewpoints / 2) % steps);
+  meta.grasp = static_cast<uint8_t>(grasps[GraspPosition(entry)]);
+  return meta;
 }
 
 size_t RecordLayout::RecordBytes() const { return CropOffset() + kCropBytes; }
@@ -460,13 +455,14 @@ Database Database::Open(const std::filesystem::path& path, bool verify_records) 
     // checksum is reported as such: its odd content is damage, not a craft.
     constexpr size_t kBlock = 64;
     uint32_t crc = 0;
+    const Enumeration enumeration(db.header_);
     std::optional<Error> impossible;
     for (size_t begin = 0; begin < count; begin += kBlock) {
       const size_t end = std::min<size_t>(count, begin + kBlock);
       crc = Crc32(crc, {db.records_ + begin * record_bytes, (end - begin) * record_bytes});
       if (impossible) continue;
       try {
-        db.VerifyRecords(begin, end);
+        db.VerifyRecords(enumeration, begin, end);
       } catch (const Error& e) {
         impossible = e;
       }
@@ -477,13 +473,12 @@ Database Database::Open(const std::filesystem::path& path, bool verify_records) 
   return db;
 }
 
-void Database::VerifyRecords(size_t begin, size_t end) const {
-  const Enumeration enumeration(header_);
+void Database::VerifyRecords(const Enumeration& enumeration, size_t begin, size_t end) const {
   const std::string source = path_.string();
   const RecordLayout& l = layout_;
   for (size_t i = begin; i < end; ++i) {
     const uint8_t* r = records_ + i * l.RecordBytes();
-    const EntryMeta meta = Meta(i), expected = enumeration.At(i);
+    const EntryMeta meta = Meta(i), expected = enumeration.At(enumeration.begin + i);
     NPHAND_THROW_CHECK(meta.grasp == expected.grasp && meta.step == expected.step &&
                            meta.with_object == expected.with_object && meta.viewpoint == expected.viewpoint,
                        source, ": record ", i, " says grasp ", int{meta.grasp}, ", step ", int{meta.step}, ", object ",

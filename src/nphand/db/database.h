@@ -69,6 +69,22 @@ struct Entry {
 // the field ("x.db: header field 'render.fov_deg' must be a number in [5, 120]").
 void ValidateHeader(const nlohmann::json& header, const std::string& source);
 
+// The fixed order of the entries of a build (the header's "order"): entry
+// ((grasp position * steps + step) * 2 + with_object) * viewpoints + viewpoint; record i of
+// a shard is entry begin + i. An entry is a pure function of its number.
+struct Enumeration {
+  std::vector<int> grasps;  // taxonomy numbers, in the build's order
+  uint64_t steps = 0, viewpoints = 0;
+  uint64_t begin = 0;       // the file's first entry (0 unless it is a shard)
+
+  // From a valid header (see ValidateHeader).
+  explicit Enumeration(const nlohmann::json& header);
+  // What entry `entry` is: grasp (taxonomy number), step, object flag and viewpoint.
+  EntryMeta At(uint64_t entry) const;
+  // The position of its grasp in `grasps`.
+  size_t GraspPosition(uint64_t entry) const;
+};
+
 // Serialises entries into the record format.
 void EncodeEntry(const Entry& entry, const RecordLayout& layout, std::span<uint8_t> record);
 
@@ -153,7 +169,7 @@ class Database {
   Database() = default;
   const uint8_t* Record(size_t i) const;
   // Throws naming the first record of [begin, end) whose content the header rules out.
-  void VerifyRecords(size_t begin, size_t end) const;
+  void VerifyRecords(const Enumeration& enumeration, size_t begin, size_t end) const;
 
   std::filesystem::path path_;
   nlohmann::json header_;
