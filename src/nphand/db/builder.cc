@@ -158,16 +158,10 @@ nlohmann::json DatabaseBuildOptions::Header() const {
       {"hand_asset_sha256", PinnedAssetSha256(Handedness::kRight)},
       {"render", {{"image_size", image_size}, {"fov_deg", fov_deg}, {"distance_m", distance}}},
       {"crop", {{"size", descriptor.crop_size}, {"margin", descriptor.crop_margin}}},
-      {"hog",
-       {{"name", descriptor.hog.Name()},
-        {"cells", descriptor.hog.cells},
-        {"bins", descriptor.hog.bins},
-        {"pyramid", descriptor.hog.pyramid},
-        {"signed", descriptor.hog.signed_orientation},
-        {"normalization", ToString(descriptor.hog.normalization)},
-        {"normalize_roll", descriptor.normalize_roll},
-        {"dimension", descriptor.Dimension()}}},
   };
+  // The descriptor's HOG block, with its roll normalisation in it (the file's layout).
+  header["hog"] = ToJson(descriptor)["hog"];
+  header["hog"]["normalize_roll"] = descriptor.normalize_roll;
   if (shard_count > 1) {
     header["shard"] = {{"index", shard_index}, {"count", shard_count}, {"begin", begin}, {"end", end}};
   }

@@ -116,19 +116,14 @@ RecordLayout LayoutOf(const nlohmann::json& header, const std::string& source) {
   return layout;
 }
 
-// The descriptor config a (validated) header records.
-DescriptorConfig DescriptorOf(const nlohmann::json& header) {
-  DescriptorConfig config;
-  config.crop_size = header["crop"]["size"].get<int>();
-  config.crop_margin = header["crop"]["margin"].get<double>();
-  const nlohmann::json& hog = header["hog"];
-  config.normalize_roll = hog["normalize_roll"].get<bool>();
-  config.hog.cells = hog["cells"].get<int>();
-  config.hog.bins = hog["bins"].get<int>();
-  config.hog.pyramid = hog["pyramid"].get<bool>();
-  config.hog.signed_orientation = hog["signed"].get<bool>();
-  config.hog.normalization = HogNormalizationFromString(hog["normalization"].get<std::string>());
-  return config;
+// The descriptor config a (validated) header records: its "crop" block and its "hog" block,
+// which holds the roll normalisation.
+DescriptorConfig DescriptorOf(const nlohmann::json& header, const std::string& source) {
+  return DescriptorConfigFromJson({{"crop_size", header["crop"]["size"]},
+                                   {"crop_margin", header["crop"]["margin"]},
+                                   {"normalize_roll", header["hog"]["normalize_roll"]},
+                                   {"hog", header["hog"]}},
+                                  source);
 }
 
 // Whether every float of `p` is a number in [min, max]. Written without early exits, so
@@ -432,7 +427,7 @@ Database Database::Open(const std::filesystem::path& path, bool verify_records) 
   auto [header, data] = ReadPrologue(db.mapped_, size, source);
   db.header_ = std::move(header);
   db.layout_ = LayoutOf(db.header_, source);
-  db.descriptor_ = DescriptorOf(db.header_);
+  db.descriptor_ = DescriptorOf(db.header_, source);
   const size_t record_bytes = db.layout_.RecordBytes();
   NPHAND_THROW_CHECK(size >= data + kFooterBytes, source, ": truncated (no footer)");
   const uint8_t* footer = db.mapped_ + size - kFooterBytes;
