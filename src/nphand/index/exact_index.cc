@@ -27,7 +27,10 @@ std::vector<std::pair<float, uint32_t>> SmallestK(std::vector<std::pair<float, u
 }
 
 std::vector<std::pair<float, uint32_t>> ExactIndex::SearchRows(std::span<const float> query, int k) const {
-  const DescriptorMatrix& base = set().descriptors;
+  return NearestRows(set().descriptors, query, k);
+}
+
+std::vector<std::pair<float, uint32_t>> NearestRows(const DescriptorMatrix& base, std::span<const float> query, int k) {
   std::vector<std::pair<float, uint32_t>> scored(base.rows());
   for (size_t r = 0; r < base.rows(); ++r) scored[r] = {SquaredDistance(query, base.Row(r)), static_cast<uint32_t>(r)};
   return SmallestK(std::move(scored), k);

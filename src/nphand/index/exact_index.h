@@ -17,6 +17,9 @@ class ExactIndex : public KnnIndex {
   std::vector<uint8_t> Body() const override { return {}; }
 };
 
+// The k rows of `base` nearest to `query` by exhaustive search: (squared distance, row),
+// ascending, ties by row.
+std::vector<std::pair<float, uint32_t>> NearestRows(const DescriptorMatrix& base, std::span<const float> query, int k);
 // The k smallest of (distance, row) pairs, ascending, ties by row.
 std::vector<std::pair<float, uint32_t>> SmallestK(std::vector<std::pair<float, uint32_t>> scored, int k);
 // Squared L2 distance between two equally long vectors.

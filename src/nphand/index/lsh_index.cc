@@ -208,11 +208,7 @@ void LshIndex::Tune(const std::vector<float>& projected, std::ostream* progress)
   std::vector<std::vector<uint32_t>> truth(count);
   for (size_t q = 0; q < count; ++q) {
     queries[q] = static_cast<uint32_t>(random.UniformIndex(rows));
-    std::vector<std::pair<float, uint32_t>> scored(rows);
-    for (size_t r = 0; r < rows; ++r) {
-      scored[r] = {SquaredDistance(base.Row(queries[q]), base.Row(r)), static_cast<uint32_t>(r)};
-    }
-    for (const auto& [distance, row] : SmallestK(std::move(scored), k)) truth[q].push_back(row);
+    for (const auto& [distance, row] : NearestRows(base, base.Row(queries[q]), k)) truth[q].push_back(row);
     std::sort(truth[q].begin(), truth[q].end());
   }
   // Recall of the candidates (re-ranking is exact, so it is the search's recall) and their
