@@ -3,6 +3,7 @@
 
 #include <filesystem>
 
+#include "nphand/eval/ann_study.h"
 #include "nphand/eval/feature_study.h"
 
 namespace nphand {
@@ -16,5 +17,16 @@ struct EvalFeaturesCommandOptions {
 };
 
 FeatureStudyResult RunEvalFeatures(const EvalFeaturesCommandOptions& options);
+
+// `nphand eval ann`: the nearest-neighbour study (paper Fig. 5) on a database.
+struct EvalAnnCommandOptions {
+  std::filesystem::path db = "out/nphand.db";
+  std::filesystem::path asset_dir = DefaultAssetDir();
+  std::filesystem::path out_dir;  // if set: ann_study.json and ann_study.png there
+  std::string name = "ann_study";
+  AnnStudyOptions study;
+};
+
+AnnStudyResult RunEvalAnn(const EvalAnnCommandOptions& options);
 
 }  // namespace nphand

@@ -122,8 +122,38 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
   info->callback([&a]() { PrintJson(nphand::RunDbInfo(a.info_path), a.json); });
 }
 
+// The backend and its options (`--<backend>-<option>`); `seed` is every backend's seed.
+void AddIndexOptions(CLI::App* cmd, nphand::IndexOptions& o, uint64_t& seed) {
+  cmd->add_option("--backend", o.backend, "exact, lsh, faiss-hnsw, faiss-ivf, hnswlib or flann")->capture_default_str();
+  nphand::LshOptions& lsh = o.lsh;
+  cmd->add_option("--lsh-tables", lsh.tables, "LSH: hash tables (L)")->capture_default_str();
+  cmd->add_option("--lsh-probes", lsh.probes, "LSH: buckets probed per table (T)")->capture_default_str();
+  cmd->add_option("--lsh-hashes", lsh.hashes, "LSH: hashes per table (M; 0: tuned)")->capture_default_str();
+  cmd->add_option("--lsh-width", lsh.bucket_width, "LSH: bucket width (W; 0: tuned)")->capture_default_str();
+  cmd->add_option("--lsh-recall", lsh.target_recall, "LSH: the recall of the true K nearest to tune for (R)")
+      ->capture_default_str();
+  cmd->add_option("--lsh-k", lsh.tune_k, "LSH: the K whose recall is tuned")->capture_default_str();
+  cmd->add_option("--lsh-queries", lsh.tune_queries, "LSH: sampled queries the tuner measures on")->capture_default_str();
+  cmd->add_option("--hnsw-m", o.hnsw.m, "HNSW (faiss-hnsw, hnswlib): links per node")->capture_default_str();
+  cmd->add_option("--hnsw-ef-construction", o.hnsw.ef_construction, "HNSW: candidates while inserting")
+      ->capture_default_str();
+  cmd->add_option("--hnsw-ef", o.hnsw.ef_search, "HNSW: candidates while searching (at least K)")->capture_default_str();
+  cmd->add_option("--hnsw-pca", o.hnsw.pca, "hnswlib: link and search this many principal components, re-rank exactly (0: off)")
+      ->capture_default_str();
+  cmd->add_option("--ivf-lists", o.ivf.lists, "IVF: k-means cells (0: 4 sqrt(n))")->capture_default_str();
+  cmd->add_option("--ivf-probes", o.ivf.probes, "IVF: cells scanned per query")->capture_default_str();
+  cmd->add_option("--ivf-encoding", o.ivf.encoding, "IVF: flat or sq8 (8-bit, re-ranked exactly)")->capture_default_str();
+  cmd->add_option("--ivf-rerank", o.ivf.rerank, "IVF sq8: candidates re-ranked, as a multiple of K")->capture_default_str();
+  cmd->add_option("--flann-algorithm", o.flann.algorithm, "FLANN: kdtree or kmeans")->capture_default_str();
+  cmd->add_option("--flann-trees", o.flann.trees, "FLANN kdtree: randomised trees")->capture_default_str();
+  cmd->add_option("--flann-branching", o.flann.branching, "FLANN kmeans: branching")->capture_default_str();
+  cmd->add_option("--flann-checks", o.flann.checks, "FLANN: leaves checked per query (-1: all)")->capture_default_str();
+  cmd->add_option("--seed", seed, "Seed of the backend's random choices")->capture_default_str();
+}
+
 struct IndexArgs {
   nphand::IndexBuildCommandOptions build;
+  uint64_t seed = 1;
   std::filesystem::path info_path = "out/nphand.db.idx";
   bool json = false;
 };
@@ -133,30 +163,49 @@ void AddIndexCommand(CLI::App& app, IndexArgs& a) {
   index->require_subcommand(1);
   CLI::App* build = index->add_subcommand("build", "Index every database entry with a hand for K-nearest search");
   build->add_option("--db", a.build.db, "Database file")->capture_default_str();
-  build->add_option("--backend", a.build.index.backend, "exact or lsh")->capture_default_str();
-  nphand::LshOptions& lsh = a.build.index.lsh;
-  build->add_option("--lsh-tables", lsh.tables, "LSH: hash tables (L)")->capture_default_str();
-  build->add_option("--lsh-probes", lsh.probes, "LSH: buckets probed per table (T)")->capture_default_str();
-  build->add_option("--lsh-hashes", lsh.hashes, "LSH: hashes per table (M; 0: tuned)")->capture_default_str();
-  build->add_option("--lsh-width", lsh.bucket_width, "LSH: bucket width (W; 0: tuned)")->capture_default_str();
-  build->add_option("--lsh-recall", lsh.target_recall, "LSH: the recall of the true K nearest to tune for (R)")
-      ->capture_default_str();
-  build->add_option("--lsh-k", lsh.tune_k, "LSH: the K whose recall is tuned")->capture_default_str();
-  build->add_option("--lsh-queries", lsh.tune_queries, "LSH: sampled queries the tuner measures on")
-      ->capture_default_str();
-  build->add_option("--seed", lsh.seed, "LSH: seed of the projections and the tuner's sample")->capture_default_str();
+  AddIndexOptions(build, a.build.index, a.seed);
   build->add_option("--out", a.build.out, "Index file to write (default: the database's path + .idx)");
   build->add_flag("--json", a.json, "Print one JSON object");
-  build->callback([&a]() { PrintJson(nphand::RunIndexBuild(a.build), a.json); });
+  build->callback([&a]() {
+    a.build.index.lsh.seed = a.build.index.hnsw.seed = a.build.index.ivf.seed = a.build.index.flann.seed = a.seed;
+    PrintJson(nphand::RunIndexBuild(a.build), a.json);
+  });
   CLI::App* info = index->add_subcommand("info", "What an index file holds (backend, parameters, its database)");
   info->add_option("path", a.info_path, "Index file")->capture_default_str();
   info->add_flag("--json", a.json, "Print one JSON object");
   info->callback([&a]() { PrintJson(nphand::RunIndexInfo(a.info_path), a.json); });
 }
 
-void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, bool& json) {
+void AddEvalAnnCommand(CLI::App* eval, nphand::EvalAnnCommandOptions& o, bool& json) {
+  CLI::App* ann = eval->add_subcommand("ann", "Nearest-neighbour study (paper Fig. 5): every backend against database size");
+  nphand::AnnStudyOptions& s = o.study;
+  ann->add_option("--db", o.db, "Database file")->capture_default_str();
+  ann->add_option("--assets", o.asset_dir, "Folder of the hand asset (renders the held-out queries)")
+      ->capture_default_str();
+  ann->add_option("--queries", s.queries, "Held-out rendered queries")->capture_default_str();
+  ann->add_option("--k", s.k, "Neighbours per query (K)")->capture_default_str();
+  ann->add_option("--fractions", s.fractions, "Database fractions, in (0, 1]")->delimiter(',')->capture_default_str();
+  ann->add_option("--backends", s.configs,
+                  "Backend settings (default all: exact, lsh, faiss-hnsw, hnswlib, hnswlib-pca64, faiss-ivf, "
+                  "faiss-ivf-sq8, flann-kdtree, flann-kmeans)")->delimiter(',');
+  ann->add_option("--seed", s.seed, "Seed of the queries and the fractions' samples")->capture_default_str();
+  ann->add_option("--out", o.out_dir, "Folder for the JSON and the plot");
+  ann->add_option("--name", o.name, "File name of the JSON and the plot")->capture_default_str();
+  ann->add_flag("--json", json, "Print one JSON object instead of the table");
+  ann->callback([&o, &json]() {
+    const nphand::AnnStudyResult result = nphand::RunEvalAnn(o);
+    if (json) {
+      std::cout << nphand::ToJson(result).dump() << "\n";
+    } else {
+      std::cout << nphand::FormatTable(result);
+    }
+  });
+}
+
+void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, nphand::EvalAnnCommandOptions& ann, bool& json) {
   CLI::App* eval = app.add_subcommand("eval", "The paper's experiments");
   eval->require_subcommand(1);
+  AddEvalAnnCommand(eval, ann, json);
   CLI::App* features = eval->add_subcommand("features", "Feature study (paper Fig. 4): pose error of feature-space neighbours");
   nphand::FeatureStudyOptions& s = o.study;
   features->add_option("--db", o.db, "Database file")->capture_default_str();
@@ -216,7 +265,8 @@ int main(int argc, char** argv) {
   IndexArgs index_args;
   AddIndexCommand(app, index_args);
   nphand::EvalFeaturesCommandOptions eval_options;
-  AddEvalCommand(app, eval_options, json);
+  nphand::EvalAnnCommandOptions ann_options;
+  AddEvalCommand(app, eval_options, ann_options, json);
   try {
     CheckSubcommands(app, argc, argv);
     app.parse(argc, argv);

@@ -1,6 +1,8 @@
 // Google Benchmark of the index stage: one K = 500 query at a time on one core, as the
 // estimator asks, on the database named by NPHAND_BENCH_DB (default out/nphand.db, which
 // `nphand db build` writes); queries are stored descriptors of entries spread over it.
+// BM_IndexFileSearch searches the index file NPHAND_BENCH_INDEX (any backend, built from
+// that database by `nphand index build`).
 #include <cstdlib>
 
 #include <benchmark/benchmark.h>
@@ -48,6 +50,18 @@ void BM_LshSearch(benchmark::State& state) {
   SearchLoop(state, *index);
 }
 BENCHMARK(BM_LshSearch)->Arg(500)->Unit(benchmark::kMillisecond);
+
+void BM_IndexFileSearch(benchmark::State& state) {
+  const char* path = std::getenv("NPHAND_BENCH_INDEX");
+  if (path == nullptr) {
+    state.SkipWithError("set NPHAND_BENCH_INDEX to an index file of the database");
+    return;
+  }
+  static const std::unique_ptr<KnnIndex> index = LoadIndex(path, BenchDatabase());
+  state.SetLabel(index->Backend());
+  SearchLoop(state, *index);
+}
+BENCHMARK(BM_IndexFileSearch)->Arg(500)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace nphand

@@ -7,7 +7,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds=60
-targets=(db_file db_content db_resume glb index)
+targets=(db_file db_content db_resume glb index index_body)
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
@@ -43,7 +43,7 @@ export ASAN_OPTIONS="detect_leaks=1"
 python3 - "$seeds" <<'PY'
 import os, struct, sys, zlib
 seeds = sys.argv[1]
-for t in ("db_file", "db_content", "db_resume", "glb", "index"):
+for t in ("db_file", "db_content", "db_resume", "glb", "index", "index_body"):
     os.makedirs(os.path.join(seeds, t), exist_ok=True)
 for name in ("tiny", "shard"):
     data = open(os.path.join(seeds, name + ".db"), "rb").read()
@@ -66,6 +66,19 @@ for name in ("tiny", "shard"):
 PY
 cp "$root/.cache/hand/right.glb" "$root/.cache/hand/left.glb" "$seeds/glb/"
 "$build/apps/nphand" index build --db "$seeds/tiny.db" --out "$seeds/index/tiny.idx" >/dev/null
+# index_body: a backend byte (the target's order) and a real body of that backend.
+selector=0
+for backend in faiss-hnsw hnswlib faiss-ivf; do
+  "$build/apps/nphand" index build --db "$seeds/tiny.db" --backend "$backend" --out "$seeds/$backend.idx" >/dev/null 2>&1
+  python3 - "$seeds/$backend.idx" "$seeds/index_body/$backend" "$selector" <<'PY'
+import struct, sys
+data = open(sys.argv[1], "rb").read()
+meta_len = struct.unpack_from("<I", data, 12)[0]
+body = data[16 + meta_len + 8:len(data) - 4]
+open(sys.argv[2], "wb").write(bytes([int(sys.argv[3])]) + body)
+PY
+  selector=$((selector + 1))
+done
 export NPHAND_FUZZ_DB="$seeds/tiny.db"  # the database the index target loads its inputs against
 
 failed=0

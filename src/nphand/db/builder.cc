@@ -12,6 +12,7 @@
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
 #include "nphand/util/parallel.h"
+#include "nphand/util/progress.h"
 
 namespace nphand {
 namespace {
@@ -82,13 +83,6 @@ nlohmann::json CoverageJson(int directions) {
   const auto round = [](double degrees) { return std::round(degrees * 1e4) / 1e4; };
   return {{"max_neighbour_deg", round(coverage.max_neighbour_deg)},
           {"covering_radius_deg", round(coverage.covering_radius_deg)}};
-}
-
-std::string Clock(double seconds) {
-  const int s = static_cast<int>(std::lround(std::max(0.0, seconds)));
-  char text[32];
-  std::snprintf(text, sizeof(text), "%d:%02d", s / 60, s % 60);
-  return text;
 }
 
 }  // namespace
@@ -196,7 +190,7 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
   std::vector<Renderer> renderers(threads, Renderer(hand));
   std::vector<cv::Mat> labels(threads);
   std::vector<uint64_t> no_hand(threads, 0);
-  double last_report = -1.0;  // progress at most once a second
+  ProgressLine line(progress, "db build", end - begin, "entries", summary.resumed);
   for (uint64_t first = begin + summary.resumed; first < end; first += kBatch) {
     const uint64_t count = std::min<uint64_t>(kBatch, end - first);
     ParallelFor(count, threads, [&](size_t i, int worker) {
@@ -204,17 +198,9 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
                   std::span<uint8_t>(batch.data() + i * record_bytes, record_bytes), &no_hand[worker]);
     });
     writer.Append(std::span<const uint8_t>(batch.data(), count * record_bytes));
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (progress != nullptr && (seconds >= last_report + 1.0 || first + count == end)) {
-      last_report = seconds;
-      const uint64_t done = writer.records_written(), made = done - summary.resumed;
-      const double rate = made / std::max(seconds, 1e-9);
-      *progress << "\rdb build: " << done << "/" << (end - begin) << " entries ("
-                << static_cast<int>(100.0 * done / (end - begin)) << "%), " << static_cast<int>(rate)
-                << "/s, ETA " << Clock((end - begin - done) / std::max(rate, 1e-9)) << "   " << std::flush;
-    }
+    line.Update(writer.records_written());
   }
-  if (progress != nullptr) *progress << "\n";
+  line.Finish();
   summary.entries = writer.records_written();
   writer.Finish();
   for (uint64_t n : no_hand) summary.no_hand += n;

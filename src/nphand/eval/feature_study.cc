@@ -8,11 +8,11 @@
 #include <numbers>
 #include <sstream>
 
-#include <faiss/IndexFlat.h>
 #include <opencv2/imgproc.hpp>
 
 #include "nphand/features/crop.h"
 #include "nphand/features/distance.h"
+#include "nphand/index/exact_index.h"
 #include "nphand/util/check.h"
 #include "nphand/util/parallel.h"
 #include "nphand/util/random.h"
@@ -64,7 +64,7 @@ std::vector<float> Describe(const StudyFeature& feature, const cv::Mat& crop) {
 using Nearest = std::vector<std::pair<float, size_t>>;
 
 // Adds one chunk's search results (candidate positions from `first`) to each query's list.
-void MergeNearest(const std::vector<float>& distances, const std::vector<faiss::Index::idx_t>& labels, int found,
+void MergeNearest(const std::vector<float>& distances, const std::vector<int64_t>& labels, int found,
                   size_t first, int fetch, std::vector<Nearest>* nearest) {
   for (size_t q = 0; q < nearest->size(); ++q) {
     Nearest& list = (*nearest)[q];
@@ -229,7 +229,7 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
   std::vector<double> candidate_roll(candidates.size(), 0.0);
   std::vector<StudyCrop> crops;
   std::vector<float> base, distances;
-  std::vector<faiss::Index::idx_t> labels;
+  std::vector<int64_t> labels;
   for (size_t first = 0; first < candidates.size(); first += options.chunk) {
     const size_t count = std::min(options.chunk, candidates.size() - first);
     if (progress != nullptr) {
@@ -251,13 +251,10 @@ FeatureStudyResult RunFeatureStudy(const Database& db, const FeatureStudyOptions
           std::copy(v.begin(), v.end(), base.begin() + c * search.dimension);
         });
       }
-      faiss::IndexFlatL2 index(search.dimension);
-      index.add(static_cast<faiss::Index::idx_t>(count), base.data());
       const int found = static_cast<int>(std::min<size_t>(search.fetch, count));
       distances.resize(query_count * found);
       labels.resize(query_count * found);
-      index.search(static_cast<faiss::Index::idx_t>(query_count), search.probe.data(), found, distances.data(),
-                   labels.data());
+      BatchNearestRows(base, search.probe, search.dimension, found, distances.data(), labels.data());
       MergeNearest(distances, labels, found, first, search.fetch, &search.nearest);
     }
   }

@@ -1,42 +1,78 @@
 #include "nphand/index/backends.h"
 
+#include <algorithm>
+
 #include "nphand/index/exact_index.h"
+#include "nphand/index/faiss_index.h"
+#include "nphand/index/flann_index.h"
+#include "nphand/index/hnswlib_index.h"
 #include "nphand/index/index_file.h"
 #include "nphand/util/check.h"
 
 namespace nphand {
 namespace {
 
-// A backend from its name, parameters and body: at build (body empty) or load.
-std::unique_ptr<KnnIndex> MakeIndex(const std::string& backend, const nlohmann::json& parameters, IndexedSet set,
-                                    const std::vector<uint8_t>& body, const std::string& source) {
-  NPHAND_THROW_CHECK(body.empty(), source, ": the ", backend, " backend has no body, the file holds ", body.size(),
-                     " bytes");
+// The backend of an index file from its name, parameters and body.
+std::unique_ptr<KnnIndex> LoadBackend(const std::string& backend, const nlohmann::json& parameters, IndexedSet set,
+                                      const std::vector<uint8_t>& body, const std::string& source) {
+  const bool has_body = backend == "faiss-hnsw" || backend == "faiss-ivf" || backend == "hnswlib";
+  NPHAND_THROW_CHECK(has_body || body.empty(), source, ": the ", backend, " backend has no body, the file holds ",
+                     body.size(), " bytes");
   if (backend == "exact") {
     NPHAND_THROW_CHECK(parameters.empty(), source, ": an exact index has no parameters");
     return std::make_unique<ExactIndex>(std::move(set));
   }
   if (backend == "lsh") {
-    return std::make_unique<LshIndex>(std::move(set), LshIndex::OptionsFromParameters(parameters, source), nullptr);
+    return LshIndex::FromParameters(std::move(set), parameters, source);
   }
+  if (backend == "faiss-hnsw") {
+    const HnswOptions options = HnswOptions::FromJson(parameters, source);
+    NPHAND_THROW_CHECK(options.pca == 0, source, ": a faiss-hnsw index has no PCA projection");
+    return LoadFaissHnsw(std::move(set), options, body, source);
+  }
+  if (backend == "hnswlib") return LoadHnswlib(std::move(set), HnswOptions::FromJson(parameters, source), body, source);
+  if (backend == "faiss-ivf") return LoadFaissIvf(std::move(set), IvfOptions::FromJson(parameters, source), body, source);
+  if (backend == "flann") return BuildFlann(std::move(set), FlannOptions::FromJson(parameters, source), nullptr);
   NPHAND_THROW(source, ": unknown index backend '", backend, "'");
 }
 
 }  // namespace
 
+const std::vector<std::string>& IndexBackends() {
+  static const std::vector<std::string> backends = {"exact", "lsh", "faiss-hnsw", "faiss-ivf", "hnswlib", "flann"};
+  return backends;
+}
+
 bool IndexOptions::Check(std::string* why) const {
-  if (backend != "exact" && backend != "lsh") {
-    *why = "unknown index backend '" + backend + "' (known: exact, lsh)";
+  const std::vector<std::string>& known = IndexBackends();
+  if (std::find(known.begin(), known.end(), backend) == known.end()) {
+    *why = "unknown index backend '" + backend + "' (known: exact, lsh, faiss-hnsw, faiss-ivf, hnswlib, flann)";
     return false;
   }
-  return backend != "lsh" || lsh.Check(why);
+  if (backend == "lsh") return lsh.Check(why);
+  if (backend == "faiss-hnsw" && hnsw.pca != 0) {
+    *why = "the PCA projection (hnsw pca) is an option of hnswlib, not of faiss-hnsw";
+    return false;
+  }
+  if (backend == "faiss-hnsw" || backend == "hnswlib") return hnsw.Check(why);
+  if (backend == "faiss-ivf") return ivf.Check(why);
+  if (backend == "flann") return flann.Check(why);
+  return true;
 }
 
 std::unique_ptr<KnnIndex> BuildIndex(const Database& db, const IndexOptions& options, std::ostream* progress) {
+  return BuildIndex(DatabaseDescriptors(db), options, progress);
+}
+
+std::unique_ptr<KnnIndex> BuildIndex(IndexedSet set, const IndexOptions& options, std::ostream* progress) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "index build: ", why);
-  if (options.backend == "lsh") return std::make_unique<LshIndex>(DatabaseDescriptors(db), options.lsh, progress);
-  return MakeIndex(options.backend, nlohmann::json::object(), DatabaseDescriptors(db), {}, "index build");
+  if (options.backend == "lsh") return std::make_unique<LshIndex>(std::move(set), options.lsh, progress);
+  if (options.backend == "faiss-hnsw") return BuildFaissHnsw(std::move(set), options.hnsw, progress);
+  if (options.backend == "hnswlib") return BuildHnswlib(std::move(set), options.hnsw, progress);
+  if (options.backend == "faiss-ivf") return BuildFaissIvf(std::move(set), options.ivf, progress);
+  if (options.backend == "flann") return BuildFlann(std::move(set), options.flann, progress);
+  return std::make_unique<ExactIndex>(std::move(set));
 }
 
 std::unique_ptr<KnnIndex> LoadIndex(const std::filesystem::path& path, const Database& db) {
@@ -49,7 +85,7 @@ std::unique_ptr<KnnIndex> LoadIndex(const std::filesystem::path& path, const Dat
   IndexedSet set = DatabaseDescriptors(db);
   NPHAND_THROW_CHECK(file.meta["entries"].get<uint64_t>() == set.ids.size(), source, ": indexes ",
                      file.meta["entries"].get<uint64_t>(), " entries, the database has ", set.ids.size(), " with a hand");
-  return MakeIndex(file.meta["backend"].get<std::string>(), file.meta["parameters"], std::move(set), file.body, source);
+  return LoadBackend(file.meta["backend"].get<std::string>(), file.meta["parameters"], std::move(set), file.body, source);
 }
 
 nlohmann::json ReadIndexMeta(const std::filesystem::path& path) { return ReadIndexFile(path).meta; }

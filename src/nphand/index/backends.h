@@ -6,14 +6,23 @@
 #include <ostream>
 #include <string>
 
+#include <vector>
+
+#include "nphand/index/ann_options.h"
 #include "nphand/index/knn_index.h"
 #include "nphand/index/lsh_index.h"
 
 namespace nphand {
 
+// exact, lsh, faiss-hnsw, faiss-ivf, hnswlib, flann.
+const std::vector<std::string>& IndexBackends();
+
 struct IndexOptions {
-  std::string backend = "exact";  // exact | lsh
+  std::string backend = "exact";  // one of IndexBackends()
   LshOptions lsh;                 // for lsh
+  HnswOptions hnsw;               // for faiss-hnsw and hnswlib
+  IvfOptions ivf;                 // for faiss-ivf
+  FlannOptions flann;             // for flann
 
   bool Check(std::string* why) const;
 };
@@ -21,6 +30,8 @@ struct IndexOptions {
 // Builds an index of every entry of `db` that shows a hand; a backend that tunes itself
 // reports to `progress` if not null.
 std::unique_ptr<KnnIndex> BuildIndex(const Database& db, const IndexOptions& options, std::ostream* progress = nullptr);
+// The same over any set of rows (the study indexes fractions of a database).
+std::unique_ptr<KnnIndex> BuildIndex(IndexedSet set, const IndexOptions& options, std::ostream* progress = nullptr);
 // Loads an index file for `db`; throws nphand::Error naming the file and the problem (not an
 // index, another version, corrupt, truncated, built from another database or descriptor).
 std::unique_ptr<KnnIndex> LoadIndex(const std::filesystem::path& path, const Database& db);

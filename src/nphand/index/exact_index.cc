@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <faiss/IndexFlat.h>
+
 namespace nphand {
 
 float SquaredDistance(std::span<const float> a, std::span<const float> b) {
@@ -19,11 +21,26 @@ float SquaredDistance(std::span<const float> a, std::span<const float> b) {
   return total;
 }
 
+void BatchNearestRows(std::span<const float> base, std::span<const float> queries, int dimension, int k,
+                      float* distances, int64_t* rows) {
+  faiss::IndexFlatL2 index(dimension);
+  index.add(static_cast<faiss::Index::idx_t>(base.size() / dimension), base.data());
+  index.search(static_cast<faiss::Index::idx_t>(queries.size() / dimension), queries.data(), k, distances, rows);
+}
+
 std::vector<std::pair<float, uint32_t>> SmallestK(std::vector<std::pair<float, uint32_t>> scored, int k) {
   const size_t keep = std::min<size_t>(k, scored.size());
   std::partial_sort(scored.begin(), scored.begin() + keep, scored.end());
   scored.resize(keep);
   return scored;
+}
+
+std::vector<std::pair<float, uint32_t>> Rerank(const DescriptorMatrix& base, std::span<const float> query,
+                                               std::span<const uint32_t> rows, int k) {
+  std::vector<std::pair<float, uint32_t>> scored;
+  scored.reserve(rows.size());
+  for (uint32_t row : rows) scored.emplace_back(SquaredDistance(query, base.Row(row)), row);
+  return SmallestK(std::move(scored), k);
 }
 
 std::vector<std::pair<float, uint32_t>> ExactIndex::SearchRows(std::span<const float> query, int k) const {

@@ -2,7 +2,6 @@
 
 #include <cstring>
 
-
 #include "nphand/index/knn_index.h"
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
@@ -11,13 +10,6 @@ namespace nphand {
 namespace {
 
 constexpr char kMagic[8] = {'N', 'P', 'H', 'A', 'N', 'D', 'I', 'X'};
-
-template <typename T>
-void Put(std::vector<uint8_t>* out, T value) {
-  const size_t at = out->size();
-  out->resize(at + sizeof(T));
-  std::memcpy(out->data() + at, &value, sizeof(T));
-}
 
 template <typename T>
 T Get(const uint8_t* p) {
@@ -63,15 +55,28 @@ IndexFile ReadIndexFile(const std::filesystem::path& path) {
 }
 
 void WriteIndexFile(const std::filesystem::path& path, const nlohmann::json& meta, const std::vector<uint8_t>& body) {
+  WriteFileAtomic(path, EncodeIndexFile(meta, body));
+}
+
+std::vector<uint8_t> EncodeIndexFile(const nlohmann::json& meta, const std::vector<uint8_t>& body) {
   const std::string text = meta.dump();
-  std::vector<uint8_t> bytes(kMagic, kMagic + 8);
-  Put<uint32_t>(&bytes, kIndexVersion);
-  Put<uint32_t>(&bytes, static_cast<uint32_t>(text.size()));
-  bytes.insert(bytes.end(), text.begin(), text.end());
-  Put<uint64_t>(&bytes, body.size());
-  bytes.insert(bytes.end(), body.begin(), body.end());
-  Put<uint32_t>(&bytes, Crc32(0, bytes));
-  WriteFileAtomic(path, bytes);
+  std::vector<uint8_t> bytes(8 + 4 + 4 + text.size() + 8 + body.size() + 4);
+  size_t at = 0;
+  const auto put = [&](const void* data, size_t size) {
+    if (size > 0) std::memcpy(bytes.data() + at, data, size);
+    at += size;
+  };
+  const uint32_t version = kIndexVersion, meta_bytes = static_cast<uint32_t>(text.size());
+  const uint64_t body_bytes = body.size();
+  put(kMagic, 8);
+  put(&version, 4);
+  put(&meta_bytes, 4);
+  put(text.data(), text.size());
+  put(&body_bytes, 8);
+  put(body.data(), body.size());
+  const uint32_t crc = Crc32(0, std::span<const uint8_t>(bytes.data(), at));
+  put(&crc, 4);
+  return bytes;
 }
 
 }  // namespace nphand

@@ -24,6 +24,8 @@ struct IndexFile {
 // Throws nphand::Error naming the file and the problem (not an index, another version,
 // truncated, trailing bytes, checksum, meta).
 IndexFile ReadIndexFile(const std::filesystem::path& path);
+// The bytes of an index file.
+std::vector<uint8_t> EncodeIndexFile(const nlohmann::json& meta, const std::vector<uint8_t>& body);
 // Writes the file atomically.
 void WriteIndexFile(const std::filesystem::path& path, const nlohmann::json& meta, const std::vector<uint8_t>& body);
 

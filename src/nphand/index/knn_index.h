@@ -61,6 +61,8 @@ class KnnIndex {
   // Search for every row of `queries`, on `threads` threads (0: all cores); equal to one
   // Search per row.
   std::vector<Neighbours> SearchBatch(const DescriptorMatrix& queries, int k, int threads = 1) const;
+  // Bytes of memory the backend holds beyond the descriptors it shares with every backend.
+  virtual size_t MemoryBytes() const = 0;
   // Backend, parameters, entries, descriptor: for `nphand index info`.
   nlohmann::json Describe() const;
 

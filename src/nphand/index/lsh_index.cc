@@ -280,12 +280,13 @@ std::vector<std::pair<float, uint32_t>> LshIndex::SearchRows(std::span<const flo
   const Eigen::Map<const RowMatrix> a(projections_.data(), columns, dimension);
   const Eigen::Map<const Eigen::VectorXf> q(query.data(), dimension);
   const Eigen::VectorXf projected = a * q;
-  const DescriptorMatrix& base = set().descriptors;
-  std::vector<std::pair<float, uint32_t>> scored;
-  for (uint32_t row : Candidates(tables_, {projected.data(), static_cast<size_t>(columns)})) {
-    scored.emplace_back(SquaredDistance(query, base.Row(row)), row);
-  }
-  return SmallestK(std::move(scored), k);
+  return Rerank(set().descriptors, query, Candidates(tables_, {projected.data(), static_cast<size_t>(columns)}), k);
+}
+
+size_t LshIndex::MemoryBytes() const {
+  size_t bytes = (projections_.size() + offsets_.size()) * sizeof(float);
+  for (const Table& table : tables_) bytes += table.keys.size() * sizeof(uint64_t) + table.rows.size() * sizeof(uint32_t);
+  return bytes;
 }
 
 nlohmann::json LshIndex::Parameters() const {
@@ -317,6 +318,19 @@ LshOptions LshIndex::OptionsFromParameters(const nlohmann::json& parameters, con
   NPHAND_THROW_CHECK(options.Check(&why) && options.hashes > 0 && options.bucket_width > 0.0, source,
                      ": invalid LSH parameters (", why.empty() ? "M and W must be set" : why, ")");
   return options;
+}
+
+std::unique_ptr<LshIndex> LshIndex::FromParameters(IndexedSet set, const nlohmann::json& parameters,
+                                                   const std::string& source) {
+  auto index = std::make_unique<LshIndex>(std::move(set), OptionsFromParameters(parameters, source), nullptr);
+  const nlohmann::json recall = parameters.value("tuned_recall", nlohmann::json()),
+                       candidates = parameters.value("tuned_candidates", nlohmann::json());
+  NPHAND_THROW_CHECK(recall.is_number() && candidates.is_number() && recall.get<double>() >= 0.0 &&
+                         recall.get<double>() <= 1.0 && candidates.get<double>() >= 0.0,
+                     source, ": the LSH parameters' tuned_recall and tuned_candidates must be numbers, the recall in [0, 1]");
+  index->tuned_recall_ = recall.get<double>();
+  index->tuned_candidates_ = candidates.get<double>();
+  return index;
 }
 
 }  // namespace nphand

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -48,12 +49,16 @@ class LshIndex : public KnnIndex {
   nlohmann::json Parameters() const override;
   // The options that rebuild this index exactly (M and W fixed), from Parameters().
   static LshOptions OptionsFromParameters(const nlohmann::json& parameters, const std::string& source);
+  // The index that Parameters() describe, with what its tuning measured.
+  static std::unique_ptr<LshIndex> FromParameters(IndexedSet set, const nlohmann::json& parameters,
+                                                  const std::string& source);
   // The recall of the true `tune_k` nearest that tuning measured (0 if M and W were given).
   double tuned_recall() const { return tuned_recall_; }
 
  protected:
   std::vector<std::pair<float, uint32_t>> SearchRows(std::span<const float> query, int k) const override;
   std::vector<uint8_t> Body() const override { return {}; }
+  size_t MemoryBytes() const override;
 
  private:
   struct Table {

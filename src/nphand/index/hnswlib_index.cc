@@ -1,0 +1,266 @@
+#include "nphand/index/hnswlib_index.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <hnswlib/hnswlib.h>
+
+#include "nphand/index/body.h"
+#include "nphand/index/exact_index.h"
+#include "nphand/util/check.h"
+#include "nphand/util/progress.h"
+#include "nphand/util/random.h"
+
+namespace nphand {
+namespace {
+
+using Graph = hnswlib::HierarchicalNSW<float>;
+
+// hnswlib's space over pointers to descriptor rows: a node stores the row's address.
+class RowPointerSpace : public hnswlib::SpaceInterface<float> {
+ public:
+  explicit RowPointerSpace(size_t dimension) : dimension_(dimension) {}
+  size_t get_data_size() override { return sizeof(const float*); }
+  hnswlib::DISTFUNC<float> get_dist_func() override { return &Distance; }
+  void* get_dist_func_param() override { return &dimension_; }
+
+ private:
+  static float Distance(const void* a, const void* b, const void* parameter) {
+    const size_t dimension = *static_cast<const size_t*>(parameter);
+    // hnswlib packs a node's data after its links: the pointer may be unaligned.
+    const float* x;
+    const float* y;
+    std::memcpy(&x, a, sizeof(x));
+    std::memcpy(&y, b, sizeof(y));
+    return SquaredDistance({x, dimension}, {y, dimension});
+  }
+  size_t dimension_;
+};
+
+using RowMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// Rows sampled to fit the PCA projection.
+constexpr size_t kPcaSample = 20000;
+
+// The highest node level a file may hold (hnswlib draws about log_M(n) levels): a crafted
+// file cannot ask for absurd link lists.
+constexpr int kMaxLevel = 64;
+
+class HnswlibIndex : public KnnIndex {
+ public:
+  HnswlibIndex(IndexedSet set, const HnswOptions& options)
+      : KnnIndex(std::move(set)), options_(options),
+        space_(static_cast<size_t>(options.pca > 0 ? options.pca : config().Dimension())),
+        graph_(std::make_unique<Graph>(&space_, std::max<size_t>(size(), 1), options.m, options.ef_construction,
+                                       options.seed)) {
+    NPHAND_THROW_CHECK(options.pca <= config().Dimension(), "hnswlib: a PCA to ", options.pca,
+                       " dimensions of a ", config().Dimension(), "-dimensional descriptor");
+    graph_->setEf(options.ef_search);
+  }
+
+  void Build(std::ostream* progress) {
+    if (options_.pca > 0) FitPca();
+    ProgressLine line(progress, "index build: hnswlib", size(), "entries");
+    for (size_t i = 0; i < size(); ++i) {
+      const float* row = GraphRow(i);
+      graph_->addPoint(&row, i);
+      line.Update(i + 1);
+    }
+    line.Finish();
+  }
+
+  // The graph of a body, checked: levels, link counts within hnswlib's limits, links to
+  // nodes, the entry point a node of the top level. Written into hnswlib's structures as its
+  // addPoint would have left them.
+  void Load(BodyReader& body) {
+    if (options_.pca > 0) {
+      const size_t d = static_cast<size_t>(config().Dimension());
+      mean_ = body.GetArray<float>(d, "PCA mean values");
+      components_ = body.GetArray<float>(d * options_.pca, "PCA component values");
+      NPHAND_THROW_CHECK(std::all_of(mean_.begin(), mean_.end(), [](float v) { return std::isfinite(v); }) &&
+                             std::all_of(components_.begin(), components_.end(), [](float v) { return std::isfinite(v); }),
+                         body.source(), ": a PCA value is not a finite number");
+      Project();
+    }
+    Graph& g = *graph_;
+    const size_t n = size();
+    const int top = body.Get<int32_t>();
+    const uint32_t entry = body.Get<uint32_t>();
+    const std::vector<int32_t> levels = body.GetArray<int32_t>(n, "node levels");
+    uint64_t most_links = 0;
+    int highest = -1;
+    for (int32_t level : levels) {
+      NPHAND_THROW_CHECK(level >= 0 && level <= kMaxLevel, body.source(), ": an HNSW node level ", level,
+                         " is outside 0..", kMaxLevel);
+      most_links += 1 + g.maxM0_ + static_cast<uint64_t>(level) * (1 + g.maxM_);
+      highest = std::max(highest, level);
+    }
+    const std::vector<uint32_t> links = body.GetArrayAtMost<uint32_t>(most_links, "link values");
+    body.Finish();
+    NPHAND_THROW_CHECK(n == 0 ? top == -1 : entry < n && top == highest && levels[entry] == top, body.source(),
+                       ": the HNSW entry point (", entry, " at level ", top, ") is not a node of the top level");
+    size_t at = 0;
+    // The link list of `level` from the stream into `list` (count, then the nodes, each a
+    // node of that level: a search follows it there).
+    auto read_list = [&](hnswlib::linklistsizeint* list, int level, size_t limit) {
+      NPHAND_THROW_CHECK(at < links.size(), body.source(), ": the HNSW link lists end early");
+      const uint32_t count = links[at++];
+      NPHAND_THROW_CHECK(count <= limit && links.size() - at >= count, body.source(), ": an HNSW link list of ", count,
+                         " nodes (at most ", limit, ")");
+      auto* nodes = reinterpret_cast<hnswlib::tableint*>(list + 1);
+      for (uint32_t j = 0; j < count; ++j) {
+        NPHAND_THROW_CHECK(links[at] < n && levels[links[at]] >= level, body.source(), ": an HNSW link at level ", level,
+                           " to node ", links[at], " of ", n, " that is not on that level");
+        nodes[j] = links[at++];
+      }
+      g.setListCount(list, static_cast<unsigned short>(count));
+    };
+    for (size_t i = 0; i < n; ++i) {
+      std::memset(g.data_level0_memory_ + i * g.size_data_per_element_, 0, g.size_data_per_element_);
+      g.element_levels_[i] = levels[i];
+      g.linkLists_[i] = nullptr;
+      g.cur_element_count = i + 1;  // from here the destructor frees node i's upper lists
+      if (levels[i] > 0) {
+        const size_t bytes = g.size_links_per_element_ * levels[i] + 1;
+        g.linkLists_[i] = static_cast<char*>(std::calloc(bytes, 1));
+        NPHAND_THROW_CHECK(g.linkLists_[i] != nullptr, body.source(), ": out of memory for the HNSW graph");
+      }
+      const float* row = GraphRow(i);
+      std::memcpy(g.getDataByInternalId(static_cast<hnswlib::tableint>(i)), &row, sizeof(row));
+      g.setExternalLabel(static_cast<hnswlib::tableint>(i), i);
+      read_list(g.get_linklist0(static_cast<hnswlib::tableint>(i)), 0, g.maxM0_);
+      for (int level = 1; level <= levels[i]; ++level) {
+        read_list(g.get_linklist(static_cast<hnswlib::tableint>(i), level), level, g.maxM_);
+      }
+    }
+    NPHAND_THROW_CHECK(at == links.size(), body.source(), ": ", links.size() - at, " link values after the last list");
+    g.enterpoint_node_ = n == 0 ? static_cast<hnswlib::tableint>(-1) : entry;
+    g.maxlevel_ = top;
+  }
+
+  std::string Backend() const override { return "hnswlib"; }
+  nlohmann::json Parameters() const override { return options_.ToJson(); }
+  size_t MemoryBytes() const override {
+    size_t bytes = graph_->max_elements_ * (graph_->size_data_per_element_ + sizeof(void*) + sizeof(int)) +
+                   (mean_.size() + components_.size() + reduced_.size()) * sizeof(float);
+    for (size_t i = 0; i < graph_->cur_element_count; ++i) {
+      bytes += graph_->size_links_per_element_ * graph_->element_levels_[i];
+    }
+    return bytes;
+  }
+
+ protected:
+  std::vector<std::pair<float, uint32_t>> SearchRows(std::span<const float> query, int k) const override {
+    const size_t kk = std::min<size_t>(k, size());
+    if (kk == 0) return {};
+    if (options_.pca > 0) {
+      const Eigen::Map<const Eigen::VectorXf> q(query.data(), query.size());
+      const Eigen::Map<const Eigen::VectorXf> mean(mean_.data(), mean_.size());
+      const Eigen::Map<const RowMatrix> components(components_.data(), options_.pca, query.size());
+      const Eigen::VectorXf projected = components * (q - mean);
+      const float* row = projected.data();
+      auto heap = graph_->searchKnn(&row, std::min<size_t>(std::max<size_t>(options_.ef_search, kk), size()));
+      std::vector<uint32_t> rows;
+      for (; !heap.empty(); heap.pop()) rows.push_back(static_cast<uint32_t>(heap.top().second));
+      return Rerank(set().descriptors, query, rows, static_cast<int>(kk));
+    }
+    const float* row = query.data();
+    auto heap = graph_->searchKnn(&row, kk);
+    std::vector<std::pair<float, uint32_t>> found;
+    found.reserve(heap.size());
+    for (; !heap.empty(); heap.pop()) found.emplace_back(heap.top().first, static_cast<uint32_t>(heap.top().second));
+    std::sort(found.begin(), found.end());
+    return found;
+  }
+
+  std::vector<uint8_t> Body() const override {
+    const Graph& g = *graph_;
+    BodyWriter body;
+    if (options_.pca > 0) {
+      body.PutArray<float>(mean_);
+      body.PutArray<float>(components_);
+    }
+    body.Put<int32_t>(size() == 0 ? -1 : g.maxlevel_);
+    body.Put<uint32_t>(size() == 0 ? 0 : g.enterpoint_node_);
+    std::vector<int32_t> levels(g.element_levels_.begin(), g.element_levels_.begin() + size());
+    body.PutArray<int32_t>(levels);
+    std::vector<uint32_t> links;
+    auto write_list = [&](hnswlib::linklistsizeint* list) {
+      const unsigned short count = g.getListCount(list);
+      const auto* nodes = reinterpret_cast<const hnswlib::tableint*>(list + 1);
+      links.push_back(count);
+      links.insert(links.end(), nodes, nodes + count);
+    };
+    for (size_t i = 0; i < size(); ++i) {
+      write_list(g.get_linklist0(static_cast<hnswlib::tableint>(i)));
+      for (int level = 1; level <= levels[i]; ++level) write_list(g.get_linklist(static_cast<hnswlib::tableint>(i), level));
+    }
+    body.PutArray<uint32_t>(links);
+    return body.Take();
+  }
+
+ private:
+  // The row a graph node points to: the descriptor, or its projection.
+  const float* GraphRow(size_t i) const {
+    return options_.pca > 0 ? reduced_.data() + i * options_.pca : set().descriptors.Row(i).data();
+  }
+
+  // The mean and the first `pca` principal axes of up to kPcaSample rows drawn with the seed.
+  void FitPca() {
+    const size_t n = size(), d = static_cast<size_t>(config().Dimension());
+    std::vector<size_t> sample(n);
+    for (size_t i = 0; i < n; ++i) sample[i] = i;
+    Random random(options_.seed);
+    for (size_t i = 0; i < std::min(n, kPcaSample); ++i) std::swap(sample[i], sample[i + random.UniformIndex(n - i)]);
+    sample.resize(std::min(n, kPcaSample));
+    Eigen::MatrixXd rows(sample.size(), d);
+    for (size_t r = 0; r < sample.size(); ++r) {
+      const std::span<const float> row = set().descriptors.Row(sample[r]);
+      for (size_t c = 0; c < d; ++c) rows(r, c) = row[c];
+    }
+    const Eigen::RowVectorXd mean = rows.colwise().mean();
+    rows.rowwise() -= mean;
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(rows.transpose() * rows);
+    mean_.assign(mean.data(), mean.data() + d);
+    components_.resize(static_cast<size_t>(options_.pca) * d);
+    for (int p = 0; p < options_.pca; ++p) {  // eigenvalues ascend: the largest are last
+      const Eigen::VectorXd axis = solver.eigenvectors().col(static_cast<Eigen::Index>(d) - 1 - p);
+      for (size_t c = 0; c < d; ++c) components_[p * d + c] = static_cast<float>(axis[c]);
+    }
+    Project();
+  }
+
+  // Every row's projection onto the components.
+  void Project() {
+    const size_t n = size(), d = static_cast<size_t>(config().Dimension());
+    const Eigen::Map<const RowMatrix> rows(set().descriptors.values().data(), n, d);
+    const Eigen::Map<const Eigen::RowVectorXf> mean(mean_.data(), d);
+    const Eigen::Map<const RowMatrix> components(components_.data(), options_.pca, d);
+    reduced_.resize(n * options_.pca);
+    Eigen::Map<RowMatrix> reduced(reduced_.data(), n, options_.pca);
+    reduced.noalias() = (rows.rowwise() - mean) * components.transpose();
+  }
+
+  HnswOptions options_;
+  RowPointerSpace space_;
+  std::unique_ptr<Graph> graph_;
+  std::vector<float> mean_, components_;  // PCA: d, and pca x d row-major
+  std::vector<float> reduced_;            // PCA: the rows projected, n x pca
+};
+
+}  // namespace
+
+std::unique_ptr<KnnIndex> BuildHnswlib(IndexedSet set, const HnswOptions& options, std::ostream* progress) {
+  return BuildAdapter<HnswlibIndex>(std::move(set), options, progress);
+}
+
+std::unique_ptr<KnnIndex> LoadHnswlib(IndexedSet set, const HnswOptions& options, std::span<const uint8_t> body,
+                                      const std::string& source) {
+  return LoadAdapter<HnswlibIndex>(std::move(set), options, body, source);
+}
+
+}  // namespace nphand
