@@ -7,6 +7,10 @@
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+// hnswlib 0.6.2's SSE path prefetches one link past the end of a full upper-level list (a
+// heap over-read AddressSanitizer reports); its SIMD distances are not used here (the nodes
+// hold row pointers, see RowPointerSpace), so it is switched off.
+#define NO_MANUAL_VECTORIZATION
 #include <hnswlib/hnswlib.h>
 
 #include "nphand/index/body.h"
