@@ -148,7 +148,8 @@ void AddIndexOptions(CLI::App* cmd, nphand::IndexOptions& o, uint64_t& seed) {
   cmd->add_option("--flann-trees", o.flann.trees, "FLANN kdtree: randomised trees")->capture_default_str();
   cmd->add_option("--flann-branching", o.flann.branching, "FLANN kmeans: branching")->capture_default_str();
   cmd->add_option("--flann-checks", o.flann.checks, "FLANN: leaves checked per query (-1: all)")->capture_default_str();
-  cmd->add_option("--seed", seed, "Seed of the backend's random choices")->capture_default_str();
+  cmd->add_option("--seed", seed, "Seed of the backend's random choices (LSH, HNSW, IVF: below 2^31; FLANN takes none)")
+      ->capture_default_str();
 }
 
 struct IndexArgs {
@@ -167,7 +168,7 @@ void AddIndexCommand(CLI::App& app, IndexArgs& a) {
   build->add_option("--out", a.build.out, "Index file to write (default: the database's path + .idx)");
   build->add_flag("--json", a.json, "Print one JSON object");
   build->callback([&a]() {
-    a.build.index.lsh.seed = a.build.index.hnsw.seed = a.build.index.ivf.seed = a.build.index.flann.seed = a.seed;
+    a.build.index.lsh.seed = a.build.index.hnsw.seed = a.build.index.ivf.seed = a.seed;
     PrintJson(nphand::RunIndexBuild(a.build), a.json);
   });
   CLI::App* info = index->add_subcommand("info", "What an index file holds (backend, parameters, its database)");

@@ -32,7 +32,7 @@ void SearchLoop(benchmark::State& state, const KnnIndex& index) {
 
 // Built once: Google Benchmark calls a benchmark several times.
 void BM_ExactSearch(benchmark::State& state) {
-  static const std::unique_ptr<KnnIndex> index = BuildIndex(BenchDatabase(), {});
+  static const std::unique_ptr<KnnIndex> index = BuildIndex(BenchDatabase(), IndexOptions::Exact());
   SearchLoop(state, *index);
 }
 BENCHMARK(BM_ExactSearch)->Arg(500)->Unit(benchmark::kMillisecond);

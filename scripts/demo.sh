@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # The demo on a fresh machine: installs what is missing, builds, renders a few hand poses
-# with and without objects from several viewpoints, and measures the renderer.
+# with and without objects from several viewpoints, builds the default database and its
+# index, runs small versions of the feature and nearest-neighbour studies, and measures the
+# renderer.
 # Everything it writes goes to out/demo/.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -33,6 +35,13 @@ echo "demo: the default database (33 grasps x 5 steps x with/without object x 64
 echo
 echo "demo: feature study (paper Fig. 4) on 500 left-out entries, HOG 8x8x8 against pose space"
 "$nphand" eval features --db "$root/out/nphand.db" --queries 500 --features joints,hog8x8x8 --out "$out" --name feature_study
+
+echo "demo: the default index of the database (hnswlib HNSW, chosen in docs/ann_study.md)"
+"$nphand" index build --db "$root/out/nphand.db" --json | tee "$out/index_build.json"
+echo
+echo "demo: nearest-neighbour study (paper Fig. 5) on 100 held-out renders, exact search against the default"
+"$nphand" eval ann --db "$root/out/nphand.db" --backends exact,hnswlib --fractions 0.25,1 --queries 100 \
+  --out "$out" --name ann_study
 
 echo "demo: renderer speed (label images of 128x128, hand + object, one core)"
 "$nphand" bench render --json | tee "$out/bench_render.json"

@@ -41,7 +41,7 @@ TEST_F(AnnStudyTest, ExactFindsItselfAndEveryRowIsMeasured) {
     EXPECT_GE(row.recall, 0.0);
     EXPECT_LE(row.recall, 1.0);
     EXPECT_GT(row.ms_median, 0.0);
-    EXPECT_GE(row.ms_p95, row.ms_median);
+    EXPECT_EQ(row.unanswered, 0u);
     EXPECT_GE(row.joint_deg, 0.0);
     EXPECT_TRUE(row.backend != "exact" || row.recall == 1.0) << "exact is its own truth";
   }

@@ -18,7 +18,7 @@ class KnnIndexTest : public testing::TinyDatabaseTest {
 };
 
 TEST_F(KnnIndexTest, ExactSearchReturnsTheTrueNearestInOrder) {
-  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), {});
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), IndexOptions::Exact());
   EXPECT_EQ(index->Backend(), "exact");
   EXPECT_EQ(index->size(), DatabaseDescriptors(db()).ids.size());
   for (size_t q : {size_t{3}, size_t{77}, size_t{150}}) {
@@ -41,7 +41,7 @@ TEST_F(KnnIndexTest, ExactSearchReturnsTheTrueNearestInOrder) {
 }
 
 TEST_F(KnnIndexTest, BatchSearchEqualsOneAtATime) {
-  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), {});
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), IndexOptions::Exact());
   std::vector<float> values;
   for (size_t q = 0; q < 20; ++q) values.insert(values.end(), db().Hog(q * 7).begin(), db().Hog(q * 7).end());
   const DescriptorMatrix queries(db().descriptor(), values);
@@ -54,7 +54,7 @@ TEST_F(KnnIndexTest, BatchSearchEqualsOneAtATime) {
 }
 
 TEST_F(KnnIndexTest, QueryDescribedDifferentlyIsRefusedNamingBoth) {
-  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), {});
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), IndexOptions::Exact());
   Descriptor query = QueryOf(3);
   query.config.normalize_roll = false;
   testing::ExpectError([&] { index->Search(query, 5); },
@@ -68,7 +68,7 @@ TEST_F(KnnIndexTest, QueryDescribedDifferentlyIsRefusedNamingBoth) {
 
 TEST_F(KnnIndexTest, SavedIndexLoadsForItsDatabaseOnly) {
   const auto dir = testing::ScratchDir();
-  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), {});
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), IndexOptions::Exact());
   index->Save(dir / "tiny.idx", db());
   const std::unique_ptr<KnnIndex> loaded = LoadIndex(dir / "tiny.idx", db());
   EXPECT_EQ(loaded->Search(QueryOf(9), 7).ids, index->Search(QueryOf(9), 7).ids);
@@ -83,7 +83,7 @@ TEST_F(KnnIndexTest, SavedIndexLoadsForItsDatabaseOnly) {
 
 TEST_F(KnnIndexTest, CorruptTruncatedForeignAndFutureIndexFilesAreRefusedByName) {
   const auto dir = testing::ScratchDir();
-  BuildIndex(db(), {})->Save(dir / "good.idx", db());
+  BuildIndex(db(), IndexOptions::Exact())->Save(dir / "good.idx", db());
   const std::vector<uint8_t> good = ReadFileBytes(dir / "good.idx");
   for (size_t i = 0; i < good.size(); ++i) {
     std::vector<uint8_t> bad = good;

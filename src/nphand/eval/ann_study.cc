@@ -98,7 +98,7 @@ std::vector<HeldOutQuery> RenderHeldOutQueries(const HandModel& hand, const Data
 std::vector<AnnConfig> StudyConfigs() {
   std::vector<AnnConfig> configs;
   auto add = [&](const std::string& name, const std::string& backend) -> IndexOptions& {
-    configs.push_back({name, {}});
+    configs.push_back({name, IndexOptions::Exact()});
     configs.back().index.backend = backend;
     return configs.back().index;
   };
@@ -173,7 +173,7 @@ AnnStudyResult RunAnnStudy(const HandModel& hand, const Database& db, const AnnS
     const size_t count = std::max<size_t>(1, static_cast<size_t>(std::llround(fraction * all.ids.size())));
     std::vector<uint32_t> rows(permutation.begin(), permutation.begin() + count);
     std::sort(rows.begin(), rows.end());
-    const std::unique_ptr<KnnIndex> exact = BuildIndex(Subset(all, rows), IndexOptions{});
+    const std::unique_ptr<KnnIndex> exact = BuildIndex(Subset(all, rows), IndexOptions::Exact());
     std::vector<std::set<entry_id_t>> truth;
     for (const HeldOutQuery& q : queries) {
       const Neighbours n = exact->Search(q.descriptor, options.k);
@@ -199,15 +199,20 @@ AnnStudyResult RunAnnStudy(const HandModel& hand, const Database& db, const AnnS
         size_t found = 0;
         for (entry_id_t id : n.ids) found += truth[q].count(id);
         recall += static_cast<double>(found) / truth[q].size();
+        if (n.ids.empty()) {  // an LSH query whose buckets are all empty
+          ++row.unanswered;
+          continue;
+        }
         const auto [j, w] = PoseError(db, n.ids.front(), queries[q]);
         joint += j;
         wrist += w;
       }
+      const size_t answered = queries.size() - row.unanswered;
       row.recall = recall / queries.size();
       row.ms_median = Percentile(ms, 0.5);
       row.ms_p95 = Percentile(ms, 0.95);
-      row.joint_deg = joint / queries.size();
-      row.wrist_deg = wrist / queries.size();
+      row.joint_deg = answered == 0 ? 0.0 : joint / answered;
+      row.wrist_deg = answered == 0 ? 0.0 : wrist / answered;
       if (progress != nullptr) {
         *progress << "eval ann: " << std::setw(3) << std::lround(100 * fraction) << "% " << std::left << std::setw(14)
                   << config.name << std::right << std::fixed << std::setprecision(3) << " recall " << row.recall
@@ -227,7 +232,8 @@ nlohmann::json ToJson(const AnnStudyResult& result) {
     rows.push_back({{"config", r.config},           {"backend", r.backend},       {"fraction", r.fraction},
                     {"entries", r.entries},         {"parameters", r.parameters}, {"recall_at_k", r.recall},
                     {"ms_per_query", r.ms_median},  {"ms_p95", r.ms_p95},         {"build_s", r.build_s},
-                    {"index_bytes", r.index_bytes}, {"joint_deg", r.joint_deg},   {"wrist_deg", r.wrist_deg}});
+                    {"index_bytes", r.index_bytes}, {"joint_deg", r.joint_deg},   {"wrist_deg", r.wrist_deg},
+                    {"unanswered", r.unanswered}});
   }
   return {{"study", "nearest-neighbour backends against database size (paper Fig. 5)"},
           {"k", result.options.k},
@@ -237,7 +243,8 @@ nlohmann::json ToJson(const AnnStudyResult& result) {
           {"measures",
            "recall_at_k: share of the exact k nearest found; ms_per_query: median over queries, one thread, one "
            "query at a time; index_bytes: memory beyond the descriptors all backends share; joint_deg, wrist_deg: "
-           "error of the arg-max (nearest) neighbour's pose"},
+           "error of the arg-max (nearest) neighbour's pose, over the queries that found any (unanswered: those "
+           "that found none)"},
           {"seconds", result.seconds},
           {"rows", rows}};
 }
@@ -308,10 +315,10 @@ cv::Mat PlotAnnStudy(const AnnStudyResult& result) {
   cv::putText(plot, "ms per query (K = " + std::to_string(result.options.k) + ", log scale)", {left, 25},
               cv::FONT_HERSHEY_SIMPLEX, 0.5, black);
   cv::putText(plot, "arg-max neighbour joint error (deg)", {panel + left, 25}, cv::FONT_HERSHEY_SIMPLEX, 0.5, black);
-  const cv::Scalar palette[] = {{0, 0, 0},     {220, 60, 30}, {40, 160, 40}, {30, 30, 200},
-                                {200, 150, 0}, {160, 0, 160}, {0, 140, 220}, {90, 90, 90}};
+  const cv::Scalar palette[] = {{0, 0, 0},     {220, 60, 30}, {40, 160, 40}, {30, 30, 200},  {200, 150, 0},
+                                {160, 0, 160}, {0, 140, 220}, {90, 90, 90}, {0, 200, 200}, {120, 60, 0}};
   for (size_t i = 0; i < names.size(); ++i) {
-    const cv::Scalar colour = palette[i % 8];
+    const cv::Scalar colour = palette[i % 10];
     std::vector<cv::Point> time_points, error_points;
     for (const AnnRow& r : result.rows) {
       if (r.config != names[i]) continue;

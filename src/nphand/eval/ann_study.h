@@ -62,7 +62,8 @@ struct AnnRow {
   double build_s = 0.0;
   size_t index_bytes = 0;           // memory beyond the shared descriptors
   double joint_deg = 0.0;           // arg-max neighbour: mean absolute joint-angle error
-  double wrist_deg = 0.0;           // and wrist-orientation error, mean over queries
+  double wrist_deg = 0.0;           // and wrist-orientation error, mean over queries answered
+  size_t unanswered = 0;            // queries the backend found no neighbour for
 };
 
 struct AnnStudyResult {

@@ -55,6 +55,7 @@ bool IvfOptions::Check(std::string* why) const {
   if (encoding != "flat" && encoding != "sq8") return Fail(why, "IVF encoding must be flat or sq8, not '" + encoding + "'");
   if (rerank < 1 || rerank > 1000) return Fail(why, "IVF rerank must be between 1 and 1000");
   if (iterations < 1 || iterations > 1000) return Fail(why, "IVF k-means iterations must be between 1 and 1000");
+  if (seed >= (uint64_t{1} << 31)) return Fail(why, "the IVF seed must be below 2^31 (FAISS's k-means takes an int)");
   return true;
 }
 
@@ -85,8 +86,8 @@ bool FlannOptions::Check(std::string* why) const {
 }
 
 nlohmann::json FlannOptions::ToJson() const {
-  return {{"algorithm", algorithm}, {"trees", trees}, {"branching", branching},
-          {"iterations", iterations}, {"checks", checks},       {"seed", seed}};
+  return {{"algorithm", algorithm}, {"trees", trees},   {"branching", branching},
+          {"iterations", iterations}, {"checks", checks}};
 }
 
 FlannOptions FlannOptions::FromJson(const nlohmann::json& json, const std::string& source) {
@@ -96,7 +97,6 @@ FlannOptions FlannOptions::FromJson(const nlohmann::json& json, const std::strin
     o.branching = json.at("branching").get<int>();
     o.iterations = json.at("iterations").get<int>();
     o.checks = json.at("checks").get<int>();
-    o.seed = json.at("seed").get<uint64_t>();
   });
 }
 

@@ -34,7 +34,7 @@ struct IvfOptions {
   std::string encoding = "flat";
   int rerank = 4;              // sq8: rerank x k candidates by 8-bit distance, re-ranked exactly
   int iterations = 10;         // k-means iterations
-  uint64_t seed = 1;           // k-means sample and initial centroids
+  uint64_t seed = 1;           // k-means sample and initial centroids; below 2^31
 
   bool Check(std::string* why) const;
   nlohmann::json ToJson() const;
@@ -42,14 +42,14 @@ struct IvfOptions {
 };
 
 // FLANN: randomised k-d trees ("kdtree") or a hierarchical k-means tree ("kmeans"),
-// searched for `checks` leaves (-1: all, an exact search).
+// searched for `checks` leaves (-1: all, an exact search). No seed: Debian's FLANN 1.9.2
+// draws its shuffles from std::random_device, so no seed would make its trees repeatable.
 struct FlannOptions {
   std::string algorithm = "kdtree";
   int trees = 4;          // kdtree
   int branching = 32;     // kmeans
   int iterations = 11;    // kmeans
   int checks = 4096;
-  uint64_t seed = 1;      // FLANN's random choices while building
 
   bool Check(std::string* why) const;
   nlohmann::json ToJson() const;

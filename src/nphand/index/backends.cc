@@ -43,6 +43,12 @@ const std::vector<std::string>& IndexBackends() {
   return backends;
 }
 
+IndexOptions IndexOptions::Exact() {
+  IndexOptions options;
+  options.backend = "exact";
+  return options;
+}
+
 bool IndexOptions::Check(std::string* why) const {
   const std::vector<std::string>& known = IndexBackends();
   if (std::find(known.begin(), known.end(), backend) == known.end()) {
@@ -67,6 +73,7 @@ std::unique_ptr<KnnIndex> BuildIndex(const Database& db, const IndexOptions& opt
 std::unique_ptr<KnnIndex> BuildIndex(IndexedSet set, const IndexOptions& options, std::ostream* progress) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "index build: ", why);
+  NPHAND_THROW_CHECK(!set.ids.empty(), "index build: the database has no entry with a hand to index");
   if (options.backend == "lsh") return std::make_unique<LshIndex>(std::move(set), options.lsh, progress);
   if (options.backend == "faiss-hnsw") return BuildFaissHnsw(std::move(set), options.hnsw, progress);
   if (options.backend == "hnswlib") return BuildHnswlib(std::move(set), options.hnsw, progress);

@@ -18,13 +18,18 @@ namespace nphand {
 const std::vector<std::string>& IndexBackends();
 
 struct IndexOptions {
-  std::string backend = "exact";  // one of IndexBackends()
+  // One of IndexBackends(). The default, hnswlib with HnswOptions' defaults, is the
+  // fastest setting of the nearest-neighbour study (docs/ann_study.md) that keeps recall@500
+  // above 0.95 on held-out renders.
+  std::string backend = "hnswlib";
   LshOptions lsh;                 // for lsh
   HnswOptions hnsw;               // for faiss-hnsw and hnswlib
   IvfOptions ivf;                 // for faiss-ivf
   FlannOptions flann;             // for flann
 
   bool Check(std::string* why) const;
+  // Exhaustive search: the ground truth.
+  static IndexOptions Exact();
 };
 
 // Builds an index of every entry of `db` that shows a hand; a backend that tunes itself

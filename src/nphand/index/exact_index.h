@@ -11,11 +11,11 @@ class ExactIndex : public KnnIndex {
   explicit ExactIndex(IndexedSet set) : KnnIndex(std::move(set)) {}
   std::string Backend() const override { return "exact"; }
   nlohmann::json Parameters() const override { return nlohmann::json::object(); }
+  size_t MemoryBytes() const override { return 0; }
 
  protected:
   std::vector<std::pair<float, uint32_t>> SearchRows(std::span<const float> query, int k) const override;
   std::vector<uint8_t> Body() const override { return {}; }
-  size_t MemoryBytes() const override { return 0; }
 };
 
 // The k rows of `base` nearest to `query` by exhaustive search: (squared distance, row),

@@ -170,7 +170,7 @@ class FaissIvfIndex : public KnnIndex {
     if (progress != nullptr) *progress << "index build: faiss-ivf: k-means, " << options_.lists << " cells\n";
     faiss::ClusteringParameters parameters;
     parameters.niter = options_.iterations;
-    parameters.seed = static_cast<int>(options_.seed);
+    parameters.seed = static_cast<int>(options_.seed);  // IvfOptions::Check keeps it below 2^31
     faiss::Clustering clustering(d, options_.lists, parameters);
     clustering.train(static_cast<faiss::Index::idx_t>(n), data, *quantizer_);
     cells_.resize(n);
@@ -227,9 +227,16 @@ class FaissIvfIndex : public KnnIndex {
     const size_t fetch = std::min<size_t>(options_.encoding == "sq8" ? size_t{1} * kk * options_.rerank : kk, size());
     std::vector<faiss::Index::idx_t> ids(fetch);
     std::vector<float> distances(fetch);
+    // The cells first, then a search of them with no statistics: IndexIVF::search adds to
+    // FAISS's global, unsynchronised indexIVF_stats, which concurrent searches would race on.
+    const size_t probes = std::min<size_t>(options_.probes, ivf_->nlist);
+    std::vector<faiss::Index::idx_t> cells(probes);
+    std::vector<float> cell_distances(probes);
+    quantizer_->search(1, query.data(), static_cast<faiss::Index::idx_t>(probes), cell_distances.data(), cells.data());
     faiss::SearchParametersIVF parameters;
-    parameters.nprobe = static_cast<size_t>(options_.probes);
-    ivf_->search(1, query.data(), static_cast<faiss::Index::idx_t>(fetch), distances.data(), ids.data(), &parameters);
+    parameters.nprobe = probes;
+    ivf_->search_preassigned(1, query.data(), static_cast<faiss::Index::idx_t>(fetch), cells.data(),
+                             cell_distances.data(), distances.data(), ids.data(), false, &parameters, nullptr);
     std::vector<uint32_t> rows;
     for (faiss::Index::idx_t id : ids) {
       if (id >= 0) rows.push_back(static_cast<uint32_t>(id));

@@ -25,7 +25,6 @@ class FlannIndex : public KnnIndex {
     } else {
       parameters = flann::KMeansIndexParams(options_.branching, options_.iterations, flann::FLANN_CENTERS_RANDOM, 0.2f);
     }
-    flann::seed_random(static_cast<unsigned int>(options_.seed));
     tree_ = std::make_unique<FlannTree>(data, parameters);
     tree_->buildIndex();
   }

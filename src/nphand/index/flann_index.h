@@ -1,7 +1,8 @@
 // FLANN behind KnnIndex ("flann"): randomised k-d trees or a hierarchical k-means tree over
-// nphand's descriptor rows (FLANN keeps pointers, not a copy). FLANN's random choices are
-// seeded, so the trees follow from the options: the index file stores only the options and
-// loading builds the trees again (FLANN's own reader never sees file bytes).
+// nphand's descriptor rows (FLANN keeps pointers, not a copy). The index file stores only
+// the options and loading builds the trees again (FLANN's own reader never sees file
+// bytes). Debian's FLANN 1.9.2 seeds its shuffles from std::random_device, so each build
+// grows other trees: the same recall, not the same answers.
 #pragma once
 
 #include <memory>

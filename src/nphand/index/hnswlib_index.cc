@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
+#include <numeric>
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
@@ -50,8 +52,7 @@ using RowMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::Ro
 // Rows sampled to fit the PCA projection.
 constexpr size_t kPcaSample = 20000;
 
-// The highest node level a file may hold (hnswlib draws about log_M(n) levels): a crafted
-// file cannot ask for absurd link lists.
+// The highest node level a file may hold (hnswlib draws about log_M(n)).
 constexpr int kMaxLevel = 64;
 
 class HnswlibIndex : public KnnIndex {
@@ -103,6 +104,11 @@ class HnswlibIndex : public KnnIndex {
       most_links += 1 + g.maxM0_ + static_cast<uint64_t>(level) * (1 + g.maxM_);
       highest = std::max(highest, level);
     }
+    // hnswlib draws a node's level with P(level >= l) = M^-l: the levels sum to about
+    // n / (M - 1). A file claiming far more would only make Load allocate upper lists.
+    const uint64_t level_sum = std::accumulate(levels.begin(), levels.end(), uint64_t{0});
+    NPHAND_THROW_CHECK(level_sum <= 2 * n + kMaxLevel, body.source(), ": the HNSW node levels sum to ", level_sum,
+                       ", more than a graph of ", n, " nodes has");
     const std::vector<uint32_t> links = body.GetArrayAtMost<uint32_t>(most_links, "link values");
     body.Finish();
     NPHAND_THROW_CHECK(n == 0 ? top == -1 : entry < n && top == highest && levels[entry] == top, body.source(),
@@ -149,7 +155,11 @@ class HnswlibIndex : public KnnIndex {
   std::string Backend() const override { return "hnswlib"; }
   nlohmann::json Parameters() const override { return options_.ToJson(); }
   size_t MemoryBytes() const override {
-    size_t bytes = graph_->max_elements_ * (graph_->size_data_per_element_ + sizeof(void*) + sizeof(int)) +
+    // Per node: its level-0 block, its upper-list pointer, its level, its lock and its slot
+    // in the visited list; hnswlib's 65,536 update locks; the PCA, if any.
+    size_t bytes = graph_->max_elements_ * (graph_->size_data_per_element_ + sizeof(void*) + sizeof(int) +
+                                            sizeof(std::mutex) + sizeof(hnswlib::vl_type)) +
+                   graph_->link_list_update_locks_.size() * sizeof(std::mutex) +
                    (mean_.size() + components_.size() + reduced_.size()) * sizeof(float);
     for (size_t i = 0; i < graph_->cur_element_count; ++i) {
       bytes += graph_->size_links_per_element_ * graph_->element_levels_[i];

@@ -54,11 +54,11 @@ class LshIndex : public KnnIndex {
                                                   const std::string& source);
   // The recall of the true `tune_k` nearest that tuning measured (0 if M and W were given).
   double tuned_recall() const { return tuned_recall_; }
+  size_t MemoryBytes() const override;
 
  protected:
   std::vector<std::pair<float, uint32_t>> SearchRows(std::span<const float> query, int k) const override;
   std::vector<uint8_t> Body() const override { return {}; }
-  size_t MemoryBytes() const override;
 
  private:
   struct Table {

@@ -13,13 +13,14 @@ std::string FormatClock(double seconds) {
   return text;
 }
 
-ProgressLine::ProgressLine(std::ostream* out, std::string label, uint64_t total, std::string unit, uint64_t already)
-    : out_(out), label_(std::move(label)), unit_(std::move(unit)), total_(total), already_(already),
-      start_(std::chrono::steady_clock::now()) {}
+ProgressLine::ProgressLine(std::ostream* out, std::string label, uint64_t total, std::string unit, uint64_t already,
+                           Clock now)
+    : out_(out), label_(std::move(label)), unit_(std::move(unit)), total_(total), already_(already), now_(now),
+      start_(now()) {}
 
 void ProgressLine::Update(uint64_t done) {
   if (out_ == nullptr) return;
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double seconds = std::chrono::duration<double>(now_() - start_).count();
   if (seconds < last_ + 1.0 && done < total_) return;
   last_ = seconds;
   printed_ = true;
