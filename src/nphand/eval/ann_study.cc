@@ -47,8 +47,7 @@ std::pair<double, double> PoseError(const Database& db, entry_id_t entry, const 
   if (db.descriptor().normalize_roll) {
     rotation = AxisAngle(Eigen::Vector3d::UnitZ(), query.descriptor.roll - db.Meta(entry).roll) * rotation;
   }
-  const double c = std::clamp(((rotation.transpose() * query.camera_from_hand).trace() - 1.0) / 2.0, -1.0, 1.0);
-  return {joint / kNumDofs * kDegPerRad, std::acos(c) * kDegPerRad};
+  return {joint / kNumDofs * kDegPerRad, RotationAngleDeg(rotation, query.camera_from_hand)};
 }
 
 double Percentile(std::vector<double> values, double p) {
@@ -128,9 +127,9 @@ bool AnnStudyOptions::Check(std::string* why) const {
   const std::vector<AnnConfig> known = StudyConfigs();
   for (const std::string& name : configs) {
     if (std::none_of(known.begin(), known.end(), [&](const AnnConfig& c) { return c.name == name; })) {
-      *why = "unknown backend setting '" + name +
-             "' (known: exact, lsh, faiss-hnsw, hnswlib, hnswlib-pca64, faiss-ivf, faiss-ivf-sq8, flann-kdtree, "
-             "flann-kmeans)";
+      *why = "unknown backend setting '" + name + "' (known:";
+      for (const AnnConfig& c : known) *why += (why->back() == ':' ? " " : ", ") + c.name;
+      *why += ")";
       return false;
     }
   }

@@ -92,11 +92,6 @@ void RerankByChamfer(const Database& db, const std::vector<size_t>& candidates, 
   });
 }
 
-double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  const double c = std::clamp(((a.transpose() * b).trace() - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c) * kDegPerRad;
-}
-
 }  // namespace
 
 std::vector<StudyFeature> PaperFeatures() {

@@ -52,7 +52,9 @@ IndexOptions IndexOptions::Exact() {
 bool IndexOptions::Check(std::string* why) const {
   const std::vector<std::string>& known = IndexBackends();
   if (std::find(known.begin(), known.end(), backend) == known.end()) {
-    *why = "unknown index backend '" + backend + "' (known: exact, lsh, faiss-hnsw, faiss-ivf, hnswlib, flann)";
+    *why = "unknown index backend '" + backend + "' (known:";
+    for (const std::string& name : known) *why += (why->back() == ':' ? " " : ", ") + name;
+    *why += ")";
     return false;
   }
   if (backend == "lsh") return lsh.Check(why);

@@ -1,5 +1,6 @@
 #include "nphand/model/hand_pose.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -153,6 +154,11 @@ HandPose FromPoseVector(const PoseVector& vector, Handedness handedness) {
 
 Eigen::Matrix3d AxisAngle(const Eigen::Vector3d& axis, double angle) {
   return Eigen::AngleAxisd(angle, axis).toRotationMatrix();
+}
+
+double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  const double c = std::clamp(((a.transpose() * b).trace() - 1.0) / 2.0, -1.0, 1.0);
+  return std::acos(c) * 180.0 / std::numbers::pi;
 }
 
 }  // namespace nphand

@@ -89,5 +89,7 @@ HandPose FromPoseVector(const PoseVector& vector, Handedness handedness);
 
 // The rotation about `axis` (unit) by `angle` radians.
 Eigen::Matrix3d AxisAngle(const Eigen::Vector3d& axis, double angle);
+// The angle of the rotation between `a` and `b`, in degrees.
+double RotationAngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
 
 }  // namespace nphand
