@@ -11,6 +11,7 @@
 #include "apps/eval_command.h"
 #include "apps/index_command.h"
 #include "apps/render_command.h"
+#include "apps/sequence_command.h"
 #include "nphand/util/check.h"
 
 namespace {
@@ -53,6 +54,43 @@ void AddRenderCommand(CLI::App& app, nphand::RenderCommandOptions& o) {
     const nphand::RenderCommandResult result = nphand::RunRender(o);
     for (const auto& path : result.files) std::cout << path.string() << "\n";
     std::cout << "hand pixels: " << result.hand_pixels << ", object pixels: " << result.object_pixels << "\n";
+  });
+}
+
+void AddSequenceCommand(CLI::App& app, nphand::SequenceCommandOptions& o) {
+  CLI::App* cmd = app.add_subcommand(
+      "sequence", "Render a grasping sequence with ground truth (frames, labels, truth.jsonl; an input of estimate)");
+  nphand::SequenceOptions& s = o.sequence;
+  cmd->add_option("--frames", s.frames, "Number of frames")->capture_default_str();
+  cmd->add_option("--fps", s.fps, "Frames per second (times in truth.jsonl, the video)")->capture_default_str();
+  cmd->add_option("--width", s.width, "Frame width, pixels")->capture_default_str();
+  cmd->add_option("--height", s.height, "Frame height, pixels")->capture_default_str();
+  cmd->add_option("--fov", s.fov_deg, "Horizontal field of view, degrees")->capture_default_str();
+  cmd->add_option("--grasp", s.grasp, "Grasp, taxonomy number 1..33 (0: chosen by the seed)")->capture_default_str();
+  cmd->add_option("--object-scale", s.object_scale,
+                  "Object size over the database's (the hand closes onto it afresh; 0: 0.8 or 1.25 by the seed)")
+      ->capture_default_str();
+  cmd->add_flag("!--no-object", s.object, "The same motion without the object");
+  cmd->add_option("--beyond-steps", s.beyond_steps, "How far the hand opens (and, empty, closes) past the database's steps")
+      ->capture_default_str();
+  cmd->add_option("--forearm", o.forearm, "none, bare or sleeved")->capture_default_str();
+  cmd->add_option("--skin", s.skin, "Skin tone: light, medium, olive, brown, dark (default: by the seed)");
+  cmd->add_option("--background", o.background, "plain, texture or clutter")->capture_default_str();
+  cmd->add_flag("--face", s.face, "Put a face beside the hand");
+  cmd->add_option("--turn", s.turn_deg, "How far the viewing direction travels, degrees")->capture_default_str();
+  cmd->add_option("--roll", s.roll_deg, "How far the camera rolls, degrees")->capture_default_str();
+  cmd->add_option("--distance", s.distance_m, "Camera to hand, metres (average)")->capture_default_str();
+  cmd->add_option("--noise", s.noise, "Sensor noise, standard deviation in 8-bit levels")->capture_default_str();
+  cmd->add_option("--hand", o.hand, "right or left (the right hand's mirror image)")->capture_default_str();
+  cmd->add_option("--seed", s.seed, "Seed of every random choice")->capture_default_str();
+  cmd->add_flag("--video", o.video, "Also write video.mp4");
+  cmd->add_option("--out", o.out_dir, "Output folder")->capture_default_str();
+  cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+  cmd->callback([&o]() {
+    const nlohmann::json description = nphand::RunSequence(o, &std::cerr);
+    std::cout << (o.out_dir / "frames").string() << "\n" << (o.out_dir / "truth.jsonl").string() << "\n"
+              << "grasp " << description["grasp"]["name"].get<std::string>() << ", skin "
+              << description["skin"].get<std::string>() << ", " << description["frames"] << " frames\n";
   });
 }
 
@@ -260,6 +298,8 @@ int main(int argc, char** argv) {
   nphand::BenchRenderOptions bench_options;
   bool json = false;
   AddRenderCommand(app, render_options);
+  nphand::SequenceCommandOptions sequence_options;
+  AddSequenceCommand(app, sequence_options);
   AddBenchCommand(app, bench_options, json);
   DbArgs db_args;
   AddDbCommand(app, db_args);

@@ -1,6 +1,6 @@
 # Every third-party package nphand uses, found once, with the versions Debian 12 ships.
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
-find_package(OpenCV 4.6 REQUIRED COMPONENTS core imgproc imgcodecs videoio)
+find_package(OpenCV 4.6 REQUIRED COMPONENTS core imgproc imgcodecs videoio objdetect)
 find_package(OpenSSL 3 REQUIRED)        # SHA-256 of the hand asset
 find_package(nlohmann_json 3.11 REQUIRED)
 find_package(CLI11 2.1 REQUIRED)

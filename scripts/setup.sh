@@ -8,7 +8,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  libopencv-dev libeigen3-dev libtinygltf-dev libstb-dev
+  libopencv-dev opencv-data libeigen3-dev libtinygltf-dev libstb-dev
   libfaiss-dev libhnswlib-dev libflann-dev liblz4-dev
   nlohmann-json3-dev libcli11-dev pybind11-dev
   libgtest-dev libgmock-dev libbenchmark-dev

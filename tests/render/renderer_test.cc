@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "nphand/scene/viewpoint.h"
 #include "nphand/util/check.h"
@@ -155,6 +156,37 @@ TEST(RendererTest, FullRenderIsConsistentAndDeterministic) {
   }
 }
 
+TEST(RendererTest, ForearmAddsItsOwnPixelsBehindTheWristAndIsClosed) {
+  Renderer renderer(RightHand());
+  // Looking at the palm, fingers up: the forearm goes down from the wrist.
+  Scene scene = HandScene({0.0, 0.0, 0.0}, NamedArticulation("relaxed"));
+  scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, RightHand().bind_centre(), 0.9);
+  const RenderedImages bare = renderer.Render(scene, kCamera);
+  scene.forearm = Forearm{};
+  RenderOptions sleeved;
+  sleeved.sleeve_colour = cv::Vec3f(200, 60, 40);
+  const RenderedImages with_arm = renderer.Render(scene, kCamera, sleeved);
+  EXPECT_GT(Count(with_arm.labels, PixelLabel::kForearm), 2000);
+  // The forearm starts inside the wrist: it hides at most a thin band of the hand.
+  EXPECT_GT(Count(with_arm.labels, PixelLabel::kHand), 0.9 * Count(bare.labels, PixelLabel::kHand));
+  const cv::Rect hand_box = cv::boundingRect(bare.labels == static_cast<int>(PixelLabel::kHand));
+  const cv::Rect arm_box = cv::boundingRect(with_arm.labels == static_cast<int>(PixelLabel::kForearm));
+  EXPECT_GT(arm_box.y + arm_box.height, hand_box.y + hand_box.height + 40);
+  // Its mesh is closed and wound outward: drawing back faces too changes no label.
+  const cv::Vec3b sleeve(200, 60, 40);
+  int sleeve_pixels = 0;
+  for (int i = 0; i < kCamera.width * kCamera.height; ++i) {
+    if (with_arm.labels.data[i] == static_cast<uint8_t>(PixelLabel::kForearm)) {
+      const cv::Vec3b c = with_arm.rgb.ptr<cv::Vec3b>()[i];
+      sleeve_pixels += c[0] > c[2];
+    }
+  }
+  EXPECT_EQ(sleeve_pixels, Count(with_arm.labels, PixelLabel::kForearm));
+  cv::Mat labels_only;
+  renderer.RenderLabels(scene, kCamera, &labels_only);
+  EXPECT_EQ(cv::norm(with_arm.labels, labels_only, cv::NORM_INF), 0.0);
+}
+
 TEST(RendererTest, BadInputsAreRefused) {
   Renderer renderer(RightHand());
   Scene scene = HandScene({}, {});
@@ -165,6 +197,12 @@ TEST(RendererTest, BadInputsAreRefused) {
   RenderOptions options;
   options.background = cv::Mat(4, 4, CV_32FC1);
   EXPECT_THROW(renderer.Render(scene, kCamera, options), Error);
+  options = {};
+  options.skin_colour = cv::Vec3f(300, 0, 0);
+  EXPECT_THROW(renderer.Render(scene, kCamera, options), Error);
+  scene.forearm = Forearm{-0.1, 1.0};
+  EXPECT_THROW(renderer.RenderLabels(scene, kCamera, &labels), Error);
+  scene.forearm.reset();
   scene.hand.handedness = Handedness::kLeft;
   EXPECT_THROW(renderer.RenderLabels(scene, kCamera, &labels), Error);
 }

@@ -136,6 +136,15 @@ PoseVector ToPoseVector(const HandPose& pose) {
   return vector;
 }
 
+HandPose MirrorPose(const HandPose& pose) {
+  HandPose mirrored = pose;
+  mirrored.handedness = pose.handedness == Handedness::kRight ? Handedness::kLeft : Handedness::kRight;
+  const Eigen::Matrix3d s = Eigen::Vector3d(-1.0, 1.0, 1.0).asDiagonal();
+  const Eigen::Matrix3d m = Eigen::Vector3d(1.0, -1.0, 1.0).asDiagonal();
+  mirrored.camera_from_hand = s * pose.camera_from_hand * m;
+  return mirrored;
+}
+
 HandPose FromPoseVector(const PoseVector& vector, Handedness handedness) {
   NPHAND_THROW_CHECK(vector.allFinite(), "pose vector has non-finite values");
   Eigen::Matrix3d m;

@@ -87,6 +87,12 @@ PoseVector ToPoseVector(const HandPose& pose);
 // of its (clamped) sine. Throws nphand::Error for non-finite values.
 HandPose FromPoseVector(const PoseVector& vector, Handedness handedness);
 
+// The same hand seen in a mirror that flips the image's x: the other handedness, the same
+// angles (they mean the same for both hands), camera_from_hand = S R M with S = diag(-1, 1, 1)
+// in the camera and M = diag(1, -1, 1) in the hand frame (whose y points to the thumb on a
+// right hand and away from it on a left one).
+HandPose MirrorPose(const HandPose& pose);
+
 // The rotation about `axis` (unit) by `angle` radians.
 Eigen::Matrix3d AxisAngle(const Eigen::Vector3d& axis, double angle);
 // The angle of the rotation between `a` and `b`, in degrees.

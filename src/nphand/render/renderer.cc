@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
 
 #include <opencv2/imgproc.hpp>
 
@@ -10,15 +12,55 @@
 namespace nphand {
 namespace {
 
-// Surface colours (BGR): a light skin tone for the hand; one colour per object in turn.
-const cv::Vec3f kSkinColour(140, 170, 225);
+// Object colours (BGR), one per object in turn.
 const std::array<cv::Vec3f, 4> kObjectColours = {cv::Vec3f(200, 120, 60), cv::Vec3f(80, 170, 90),
                                                  cv::Vec3f(60, 90, 200), cv::Vec3f(170, 80, 170)};
 constexpr size_t kMaxCachedMeshes = 64;
+// Raster labels of the shading pass: objects are told apart by drawing order from here on.
+constexpr int kFirstShadedObjectLabel = 4;
+constexpr int kForearmSegments = 32;
 
-void CheckInputs(const Intrinsics& intrinsics, const RenderOptions* options) {
+bool IsColour(const cv::Vec3f& c) {
+  return std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]) && c[0] >= 0 && c[1] >= 0 && c[2] >= 0 &&
+         c[0] <= 255 && c[1] <= 255 && c[2] <= 255;
+}
+
+// An elliptic truncated cone along -x: rings at x0 (wrist end, inside the mesh) and x1
+// (elbow end), centred on (y, z) = centre, with caps; wound outward.
+TriangleMesh MakeForearmMesh(const Eigen::Vector2f& centre, const Eigen::Vector2f& wrist_radii, double x0, double x1,
+                             double elbow_scale) {
+  TriangleMesh mesh;
+  const int n = kForearmSegments;
+  for (int end = 0; end < 2; ++end) {
+    const float x = static_cast<float>(end == 0 ? x0 : x1);
+    const float scale = end == 0 ? 1.0f : static_cast<float>(elbow_scale);
+    for (int i = 0; i < n; ++i) {
+      const float a = static_cast<float>(2.0 * std::numbers::pi * i / n);
+      const float cy = std::cos(a), sz = std::sin(a);
+      mesh.vertices.emplace_back(x, centre.x() + scale * wrist_radii.x() * cy, centre.y() + scale * wrist_radii.y() * sz);
+      mesh.normals.push_back(Eigen::Vector3f(0.0f, cy / wrist_radii.x(), sz / wrist_radii.y()).normalized());
+    }
+  }
+  for (int end = 0; end < 2; ++end) {
+    mesh.vertices.emplace_back(static_cast<float>(end == 0 ? x0 : x1), centre.x(), centre.y());
+    mesh.normals.emplace_back(end == 0 ? 1.0f : -1.0f, 0.0f, 0.0f);
+  }
+  const int cap0 = 2 * n, cap1 = 2 * n + 1;
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    // Side: the ring at x0 lies on +x of the ring at x1.
+    mesh.triangles.emplace_back(i, n + i, n + j);
+    mesh.triangles.emplace_back(i, n + j, j);
+    mesh.triangles.emplace_back(cap0, i, j);
+    mesh.triangles.emplace_back(cap1, n + j, n + i);
+  }
+  return mesh;
+}
+
+void CheckInputs(const Scene& scene, const Intrinsics& intrinsics, const RenderOptions* options) {
   std::string why;
   NPHAND_THROW_CHECK(intrinsics.Check(&why), "render: ", why);
+  NPHAND_THROW_CHECK(!scene.forearm.has_value() || scene.forearm->Check(&why), "render: ", why);
   if (options != nullptr) NPHAND_THROW_CHECK(options->Check(&why), "render: ", why);
 }
 
@@ -37,6 +79,10 @@ bool RenderOptions::Check(std::string* why) const {
     *why = "ambient must be within [0, 1]";
     return false;
   }
+  if (!IsColour(skin_colour) || (sleeve_colour.has_value() && !IsColour(*sleeve_colour))) {
+    *why = "colours must be BGR values within [0, 255]";
+    return false;
+  }
   return true;
 }
 
@@ -47,6 +93,26 @@ const TriangleMesh& Renderer::ObjectMesh(const ObjectSpec& spec) {
   if (mesh_cache_.size() >= kMaxCachedMeshes) mesh_cache_.clear();
   mesh_cache_.emplace_back(spec, MakeObjectMesh(spec));
   return mesh_cache_.back().second;
+}
+
+const TriangleMesh& Renderer::ForearmMesh(const Forearm& forearm) {
+  if (forearm_cache_.has_value() && forearm_cache_->first.length == forearm.length &&
+      forearm_cache_->first.elbow_scale == forearm.elbow_scale) {
+    return forearm_cache_->second;
+  }
+  // The wrist's cross-section: the bind-pose vertices within 1 cm of the mesh's proximal end.
+  float min_x = std::numeric_limits<float>::max();
+  for (const Eigen::Vector3f& v : hand_.bind_vertices()) min_x = std::min(min_x, v.x());
+  Eigen::Vector2f low(std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
+  Eigen::Vector2f high = -low;
+  for (const Eigen::Vector3f& v : hand_.bind_vertices()) {
+    if (v.x() > min_x + 0.01f) continue;
+    low = low.cwiseMin(v.tail<2>());
+    high = high.cwiseMax(v.tail<2>());
+  }
+  forearm_cache_.emplace(forearm, MakeForearmMesh(0.5f * (low + high), 0.5f * (high - low), min_x + 0.01,
+                                                  min_x - forearm.length, forearm.elbow_scale));
+  return forearm_cache_->second;
 }
 
 int Renderer::ObjectTriangleCount(const Scene& scene) {
@@ -76,12 +142,11 @@ void Renderer::Rasterize(const Scene& scene, const Intrinsics& intrinsics, const
   RasterizeTriangles(intrinsics, vertices_, hand_.triangles(), shading ? intensity_ : std::span<const float>(),
                      static_cast<uint8_t>(PixelLabel::kHand), Faces::kFrontOnly, &target_);
 
-  for (size_t o = 0; o < scene.objects.size(); ++o) {
-    const SceneObject& object = scene.objects[o];
-    const TriangleMesh& mesh = ObjectMesh(object.spec);
-    const Eigen::Matrix3f rotation = (scene.hand.camera_from_hand * object.hand_from_object.linear()).cast<float>();
+  // A mesh placed in the hand frame by `hand_from_mesh`, drawn with `label`.
+  auto draw = [&](const TriangleMesh& mesh, const Eigen::Isometry3d& hand_from_mesh, uint8_t label) {
+    const Eigen::Matrix3f rotation = (scene.hand.camera_from_hand * hand_from_mesh.linear()).cast<float>();
     const Eigen::Vector3f translation =
-        (scene.hand.camera_from_hand * object.hand_from_object.translation()).cast<float>() + wrist;
+        (scene.hand.camera_from_hand * hand_from_mesh.translation()).cast<float>() + wrist;
     vertices_.resize(mesh.vertices.size());
     for (size_t v = 0; v < mesh.vertices.size(); ++v) vertices_[v] = rotation * mesh.vertices[v] + translation;
     if (shading) {
@@ -89,29 +154,37 @@ void Renderer::Rasterize(const Scene& scene, const Intrinsics& intrinsics, const
       for (size_t v = 0; v < mesh.normals.size(); ++v) normals_[v] = rotation * mesh.normals[v];
       shade(normals_);
     }
-    // Objects carry label kObject; the shading pass tells objects apart by drawing order.
-    RasterizeTriangles(intrinsics, vertices_, mesh.triangles, shading ? intensity_ : std::span<const float>(),
-                       static_cast<uint8_t>(static_cast<int>(PixelLabel::kObject) + (shading ? o : 0)),
+    RasterizeTriangles(intrinsics, vertices_, mesh.triangles, shading ? intensity_ : std::span<const float>(), label,
                        Faces::kFrontOnly, &target_);
+  };
+  if (scene.forearm.has_value()) {
+    draw(ForearmMesh(*scene.forearm), Eigen::Isometry3d::Identity(), static_cast<uint8_t>(PixelLabel::kForearm));
+  }
+  for (size_t o = 0; o < scene.objects.size(); ++o) {
+    // Objects carry label kObject; the shading pass tells objects apart by drawing order.
+    draw(ObjectMesh(scene.objects[o].spec), scene.objects[o].hand_from_object,
+         static_cast<uint8_t>(shading ? kFirstShadedObjectLabel + static_cast<int>(o) : static_cast<int>(PixelLabel::kObject)));
   }
 }
 
 void Renderer::RenderLabels(const Scene& scene, const Intrinsics& intrinsics, cv::Mat* labels) {
-  CheckInputs(intrinsics, nullptr);
+  CheckInputs(scene, intrinsics, nullptr);
   Rasterize(scene, intrinsics, nullptr);
   labels->create(intrinsics.height, intrinsics.width, CV_8UC1);
   std::copy(target_.label.begin(), target_.label.end(), labels->ptr<uint8_t>());
 }
 
 RenderedImages Renderer::Render(const Scene& scene, const Intrinsics& intrinsics, const RenderOptions& options) {
-  CheckInputs(intrinsics, &options);
-  NPHAND_THROW_CHECK(scene.objects.size() < 250, "render: too many objects (", scene.objects.size(), ")");
+  CheckInputs(scene, intrinsics, &options);
+  NPHAND_THROW_CHECK(scene.objects.size() < 250 - kFirstShadedObjectLabel, "render: too many objects (",
+                     scene.objects.size(), ")");
   Rasterize(scene, intrinsics, &options);
   const int h = intrinsics.height, w = intrinsics.width;
   RenderedImages images;
   images.labels.create(h, w, CV_8UC1);
   for (int i = 0; i < h * w; ++i) {
-    images.labels.ptr<uint8_t>()[i] = std::min<uint8_t>(target_.label[i], static_cast<uint8_t>(PixelLabel::kObject));
+    const uint8_t label = target_.label[i];
+    images.labels.ptr<uint8_t>()[i] = label >= kFirstShadedObjectLabel ? static_cast<uint8_t>(PixelLabel::kObject) : label;
   }
   if (options.depth) {
     images.depth.create(h, w, CV_32FC1);
@@ -127,9 +200,10 @@ RenderedImages Renderer::Render(const Scene& scene, const Intrinsics& intrinsics
     for (int i = 0; i < h * w; ++i) {
       const uint8_t label = target_.label[i];
       if (label == 0) continue;
-      const cv::Vec3f colour = label == static_cast<uint8_t>(PixelLabel::kHand)
-                                   ? kSkinColour
-                                   : kObjectColours[(label - static_cast<int>(PixelLabel::kObject)) % kObjectColours.size()];
+      const cv::Vec3f colour =
+          label == static_cast<uint8_t>(PixelLabel::kHand)      ? options.skin_colour
+          : label == static_cast<uint8_t>(PixelLabel::kForearm) ? options.sleeve_colour.value_or(options.skin_colour)
+                                                                : kObjectColours[(label - kFirstShadedObjectLabel) % kObjectColours.size()];
       images.rgb.ptr<cv::Vec3b>()[i] = cv::Vec3b(cv::saturate_cast<uchar>(colour[0] * target_.shade[i]),
                                                  cv::saturate_cast<uchar>(colour[1] * target_.shade[i]),
                                                  cv::saturate_cast<uchar>(colour[2] * target_.shade[i]));

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,7 +23,10 @@
 namespace nphand {
 
 // Values of the label image.
-enum class PixelLabel : uint8_t { kBackground = 0, kHand = 1, kObject = 2 };
+enum class PixelLabel : uint8_t { kBackground = 0, kHand = 1, kObject = 2, kForearm = 3 };
+
+// The default skin colour (BGR, 0..255): a light tone.
+inline const cv::Vec3f kDefaultSkinColour(140, 170, 225);
 
 struct RenderOptions {
   bool depth = true;  // fill RenderedImages::depth
@@ -32,6 +36,8 @@ struct RenderOptions {
   // Where the light comes from, in the camera frame (towards the light).
   Eigen::Vector3d light_direction = Eigen::Vector3d(-0.4, -0.6, -1.0);
   double ambient = 0.35;  // light on surfaces facing away from the light, 0..1
+  cv::Vec3f skin_colour = kDefaultSkinColour;  // BGR, 0..255, of the hand (and a bare forearm)
+  std::optional<cv::Vec3f> sleeve_colour;      // BGR of the forearm if it is sleeved
 
   bool Check(std::string* why) const;
 };
@@ -63,6 +69,7 @@ class Renderer {
   // Rasterises the scene into target_; intensities are computed when `options` is given.
   void Rasterize(const Scene& scene, const Intrinsics& intrinsics, const RenderOptions* options);
   const TriangleMesh& ObjectMesh(const ObjectSpec& spec);
+  const TriangleMesh& ForearmMesh(const Forearm& forearm);
 
   const HandModel& hand_;
   RasterTarget target_;
@@ -70,6 +77,7 @@ class Renderer {
   std::vector<Eigen::Vector3f> vertices_, normals_;
   std::vector<float> intensity_;
   std::vector<std::pair<ObjectSpec, TriangleMesh>> mesh_cache_;
+  std::optional<std::pair<Forearm, TriangleMesh>> forearm_cache_;
 };
 
 }  // namespace nphand

@@ -1,4 +1,5 @@
 #include "nphand/scene/object.h"
+#include "nphand/scene/scene.h"
 
 #include <cmath>
 #include <numbers>
@@ -196,6 +197,18 @@ double SignedDistance(const ObjectSpec& spec, const Eigen::Vector3d& p) {
   }
   NPHAND_CHECK(false, "unknown object shape");
   return 0.0;
+}
+
+}  // namespace nphand
+
+namespace nphand {
+
+bool Forearm::Check(std::string* why) const {
+  if (!(length > 0.0 && length <= 1.0) || !(elbow_scale >= 0.5 && elbow_scale <= 3.0)) {
+    *why = "a forearm's length must be within (0, 1] metres and its elbow scale within [0.5, 3]";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace nphand
