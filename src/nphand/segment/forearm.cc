@@ -1,0 +1,163 @@
+#include "nphand/segment/forearm.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "nphand/util/check.h"
+
+namespace nphand {
+namespace {
+
+struct Profile {
+  std::vector<double> width;  // extent across the axis per 1-pixel slice, smoothed
+  double t0 = 0.0;            // axis coordinate of slice 0
+};
+
+// Which sides of the slice at one end touch the frame: counts of the end's pixels that lie
+// on a bordering edge.
+int EndTouches(const std::vector<cv::Point>& points, const std::vector<double>& t, double from, double to, int border,
+               const cv::Size& size) {
+  int touches = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (t[i] < from || t[i] > to) continue;
+    const cv::Point& p = points[i];
+    touches += ((border & 1) && p.x == 0) || ((border & 2) && p.y == 0) || ((border & 4) && p.x == size.width - 1) ||
+               ((border & 8) && p.y == size.height - 1);
+  }
+  return touches;
+}
+
+}  // namespace
+
+bool ForearmCutOptions::Check(std::string* why) const {
+  if (!(widen_ratio > 1.0 && widen_ratio < 5.0) || !(min_arm_width > 0.0 && min_arm_width < 1.0) ||
+      !(min_arm_length >= 0.0 && min_arm_length < 10.0) || !(min_arm_length_at_edge >= 0.0 && min_arm_length_at_edge < 10.0)) {
+    *why = "forearm cut needs widen ratio in (1, 5), arm width in (0, 1) and arm length in [0, 10)";
+    return false;
+  }
+  return true;
+}
+
+ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions& options) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "forearm: ", why);
+  NPHAND_THROW_CHECK(!region.empty() && region.type() == CV_8UC1, "forearm: a region must be an 8-bit single-channel mask");
+  ForearmCut result;
+  result.hand = region != 0;
+  std::vector<cv::Point> points;
+  cv::findNonZero(result.hand, points);
+  if (points.size() < 50) return result;
+
+  const cv::Moments m = cv::moments(result.hand, true);
+  const cv::Point2d centre(m.m10 / m.m00, m.m01 / m.m00);
+  const double angle = 0.5 * std::atan2(2.0 * m.mu11, m.mu20 - m.mu02);
+  const cv::Point2d axis(std::cos(angle), std::sin(angle)), across(-std::sin(angle), std::cos(angle));
+
+  std::vector<double> t(points.size()), s(points.size());
+  double t_min = 1e300, t_max = -1e300;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const cv::Point2d d = cv::Point2d(points[i]) - centre;
+    t[i] = d.dot(axis);
+    s[i] = d.dot(across);
+    t_min = std::min(t_min, t[i]);
+    t_max = std::max(t_max, t[i]);
+  }
+  const int slices = static_cast<int>(std::floor(t_max - t_min)) + 1;
+  if (slices < 8) return result;
+  std::vector<double> low(slices, 1e300), high(slices, -1e300);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const int k = std::min(slices - 1, static_cast<int>(t[i] - t_min));
+    low[k] = std::min(low[k], s[i]);
+    high[k] = std::max(high[k], s[i]);
+  }
+  std::vector<double> raw(slices, 0.0);
+  for (int k = 0; k < slices; ++k) raw[k] = high[k] >= low[k] ? high[k] - low[k] + 1.0 : 0.0;
+  // Smooth over about 3 % of the length so that one ragged slice does not decide.
+  const int half = std::max(1, slices / 60);
+  std::vector<double> width(slices, 0.0);
+  for (int k = 0; k < slices; ++k) {
+    double sum = 0.0;
+    int n = 0;
+    for (int j = std::max(0, k - half); j <= std::min(slices - 1, k + half); ++j, ++n) sum += raw[j];
+    width[k] = sum / n;
+  }
+  const double widest = *std::max_element(width.begin(), width.end());
+
+  const double reach = 0.05 * slices;
+  const int touch_low = EndTouches(points, t, t_min, t_min + reach, border, region.size());
+  const int touch_high = EndTouches(points, t, t_max - reach, t_max, border, region.size());
+  auto touches_edge = [&](int direction) { return (direction > 0 ? touch_low : touch_high) > 0; };
+
+  // From one end (direction +1: from t_min), the narrowest point before the widening, or -1.
+  auto find_wrist = [&](int direction, double* wrist_width) {
+    auto index = [&](int step) { return direction > 0 ? step : slices - 1 - step; };
+    // Skip the end's cap, where the width still grows (a rounded end, or an arm that leaves
+    // the frame obliquely).
+    int first = 0;
+    while (first + 1 < slices && width[index(first + 1)] > 1.02 * width[index(first)]) ++first;
+    double narrowest = 1e300;
+    int at = -1;
+    for (int step = first; step < slices; ++step) {
+      const int k = index(step);
+      // The narrow stretch's end nearest the hand: an arm of even width is cut where it ends.
+      if (width[k] < narrowest) {
+        narrowest = width[k];
+        at = step;
+      } else if (width[k] <= 1.05 * narrowest) {
+        at = step;
+      }
+      if (step > first && width[k] > options.widen_ratio * narrowest) {
+        *wrist_width = narrowest;
+        // An arm: long enough before the cut and not as thin as a finger.
+        const double length = at >= 0 && touches_edge(direction) ? options.min_arm_length_at_edge : options.min_arm_length;
+        if (at >= length * narrowest && narrowest >= options.min_arm_width * widest) return at;
+        return -1;
+      }
+    }
+    return -1;
+  };
+  double width_low = 0.0, width_high = 0.0;
+  const int from_low = find_wrist(+1, &width_low);
+  const int from_high = find_wrist(-1, &width_high);
+  int direction = 0;
+  if (from_low >= 0 && from_high >= 0) {
+    // Both ends could be an arm: the one entering from the frame's edge, else the longer run.
+    if (touch_low != touch_high) {
+      direction = touch_low > touch_high ? +1 : -1;
+    } else {
+      direction = from_low >= from_high ? +1 : -1;
+    }
+  } else if (from_low >= 0) {
+    direction = +1;
+  } else if (from_high >= 0) {
+    direction = -1;
+  }
+  if (direction == 0) return result;
+
+  const int step = direction > 0 ? from_low : from_high;
+  const double cut_t = direction > 0 ? t_min + step + 0.5 : t_max - step - 0.5;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if ((direction > 0 && t[i] < cut_t) || (direction < 0 && t[i] > cut_t)) result.hand.at<uint8_t>(points[i]) = 0;
+  }
+  // The cut may leave crumbs of the arm's edge: keep the largest piece.
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(result.hand, labels, stats, centroids, 8, CV_32S);
+  if (count > 2) {
+    int best = 1;
+    for (int l = 2; l < count; ++l) {
+      if (stats.at<int>(l, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = l;
+    }
+    result.hand = labels == best;
+  }
+  result.cut = true;
+  result.wrist_width = direction > 0 ? width_low : width_high;
+  const int k = direction > 0 ? step : slices - 1 - step;
+  result.wrist = centre + axis * cut_t + across * (0.5 * (low[k] + high[k]));
+  result.arm_direction = direction > 0 ? -axis : axis;
+  return result;
+}
+
+}  // namespace nphand

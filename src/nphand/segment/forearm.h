@@ -1,0 +1,42 @@
+// Cutting a skin region at the wrist: real hands come with a bare forearm that the
+// database's mesh lacks, and an arm in the crop changes its scale and shape. The region's
+// principal axis runs along the arm; its width profile along that axis narrows from the
+// elbow to the wrist and widens at the hand, so the cut goes through the narrowest point
+// before the widening, across the axis. A region without a forearm has no such stretch and
+// is left whole.
+#pragma once
+
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace nphand {
+
+struct ForearmCutOptions {
+  // The hand starts where the width first exceeds this many times the narrowest width
+  // seen so far, walking from the arm's end.
+  double widen_ratio = 1.3;
+  // An arm is at least this wide relative to the widest part (fingers are narrower).
+  double min_arm_width = 0.3;
+  // ...and at least this long, in wrist widths, before the cut (shorter: no forearm); a
+  // group of fingers can pass for an arm, but not for a long one.
+  double min_arm_length = 1.2;
+  // The same for an end that enters from the frame's edge, as an arm does.
+  double min_arm_length_at_edge = 0.3;
+  bool Check(std::string* why) const;
+};
+
+struct ForearmCut {
+  cv::Mat hand;                 // CV_8UC1, the region without its forearm (255 = hand)
+  bool cut = false;             // a forearm was found and removed
+  cv::Point2d wrist;            // the cut's centre (pixels of the mask), if cut
+  cv::Point2d arm_direction;    // unit, from the wrist towards the elbow, if cut
+  double wrist_width = 0.0;     // pixels across the cut, if cut
+};
+
+// The hand part of `region` (CV_8UC1, non-zero = one skin region). `border` says which
+// sides of the mask touch the frame's edge (an arm usually comes in from one): bit 0 left,
+// 1 top, 2 right, 3 bottom. Throws nphand::Error for another type or invalid options.
+ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions& options = {});
+
+}  // namespace nphand

@@ -1,0 +1,179 @@
+#include "nphand/segment/skin.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/objdetect.hpp>
+
+#include "nphand/util/check.h"
+
+namespace nphand {
+
+struct SkinSegmenter::FaceDetector {
+  cv::CascadeClassifier cascade;
+};
+
+bool SkinOptions::Check(std::string* why) const {
+  auto byte = [](int v) { return v >= 0 && v <= 255; };
+  if (!byte(cr_min) || !byte(cr_max) || !byte(cb_min) || !byte(cb_max) || !byte(y_min) || cr_min > cr_max ||
+      cb_min > cb_max) {
+    *why = "skin box bounds must be within 0..255 with min <= max";
+  } else if (!(learn_rate > 0.0 && learn_rate <= 1.0) || !(keep >= 0.0 && keep <= add && add <= 1.0)) {
+    *why = "skin adaptation needs 0 < learn rate <= 1 and 0 <= keep <= add <= 1";
+  } else if (bins < 4 || bins > 256 || 256 % bins != 0) {
+    *why = "skin histogram bins must divide 256 (4..256)";
+  } else if (open_px < 0 || open_px > 31 || close_px < 0 || close_px > 31) {
+    *why = "skin morphology sizes must be within 0..31 pixels";
+  } else if (!(min_area > 0.0 && min_area < 1.0)) {
+    *why = "the smallest skin region must be within (0, 1) of the frame";
+  } else if (face_interval < 1) {
+    *why = "the face interval must be at least 1 frame";
+  } else {
+    return true;
+  }
+  return false;
+}
+
+cv::Mat SkinSegmentation::RegionMask(const SkinRegion& region) const {
+  return labels(region.box) == region.label;
+}
+
+SkinSegmenter::SkinSegmenter(const SkinOptions& options) : options_(options) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "skin: ", why);
+  if (!options.face_cascade.empty()) {
+    NPHAND_THROW_CHECK(std::filesystem::is_regular_file(options.face_cascade), options.face_cascade,
+                       ": no face cascade there (install Debian's opencv-data, or turn face masking off)");
+    detector_ = std::make_shared<FaceDetector>();
+    NPHAND_THROW_CHECK(detector_->cascade.load(options.face_cascade), options.face_cascade,
+                       ": not a face cascade OpenCV can read");
+  }
+  Reset();
+}
+
+void SkinSegmenter::Reset() {
+  hand_hist_ = cv::Mat::zeros(options_.bins, options_.bins, CV_32FC1);
+  rest_hist_ = cv::Mat::zeros(options_.bins, options_.bins, CV_32FC1);
+  learned_ = 0;
+  frames_ = 0;
+  faces_.clear();
+  RebuildLookup();
+}
+
+void SkinSegmenter::RebuildLookup() {
+  lookup_.create(256, 256, CV_8UC1);
+  const int shift = 256 / options_.bins;
+  for (int cr = 0; cr < 256; ++cr) {
+    for (int cb = 0; cb < 256; ++cb) {
+      const bool in_box = cr >= options_.cr_min && cr <= options_.cr_max && cb >= options_.cb_min && cb <= options_.cb_max;
+      bool skin = in_box;
+      if (learned_ > 0) {
+        const float h = hand_hist_.at<float>(cr / shift, cb / shift), r = rest_hist_.at<float>(cr / shift, cb / shift);
+        // Chroma neither side has seen stays with the box.
+        if (h + r > 1e-5f) {
+          const double p = h / (h + r);
+          skin = (in_box && p >= options_.keep) || p >= options_.add;
+        }
+      }
+      lookup_.at<uint8_t>(cr, cb) = skin ? 255 : 0;
+    }
+  }
+}
+
+SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
+  NPHAND_THROW_CHECK(!bgr.empty() && bgr.type() == CV_8UC3, "skin: a frame must be a non-empty 8-bit BGR image");
+  cv::Mat ycrcb;
+  cv::cvtColor(bgr, ycrcb, cv::COLOR_BGR2YCrCb);
+  SkinSegmentation out;
+  out.skin.create(bgr.size(), CV_8UC1);
+  for (int y = 0; y < ycrcb.rows; ++y) {
+    const cv::Vec3b* in = ycrcb.ptr<cv::Vec3b>(y);
+    uint8_t* skin = out.skin.ptr<uint8_t>(y);
+    for (int x = 0; x < ycrcb.cols; ++x) {
+      skin[x] = in[x][0] >= options_.y_min ? lookup_.at<uint8_t>(in[x][1], in[x][2]) : 0;
+    }
+  }
+  if (options_.open_px > 1) {
+    cv::morphologyEx(out.skin, out.skin, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(options_.open_px, options_.open_px)));
+  }
+  if (options_.close_px > 1) {
+    cv::morphologyEx(out.skin, out.skin, cv::MORPH_CLOSE,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(options_.close_px, options_.close_px)));
+  }
+
+  if (detector_ != nullptr && frames_ % options_.face_interval == 0) {
+    cv::Mat grey;
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    double scale = 1.0;
+    while (grey.cols > 320) {
+      cv::pyrDown(grey, grey);
+      scale *= 2.0;
+    }
+    cv::equalizeHist(grey, grey);
+    std::vector<cv::Rect> found;
+    detector_->cascade.detectMultiScale(grey, found, 1.1, 4, 0, cv::Size(24, 24));
+    faces_.clear();
+    for (const cv::Rect& f : found) {
+      faces_.emplace_back(static_cast<int>(f.x * scale), static_cast<int>(f.y * scale), static_cast<int>(f.width * scale),
+                          static_cast<int>(f.height * scale));
+    }
+  }
+  ++frames_;
+  out.faces = faces_;
+
+  cv::Mat stats, centroids;
+  const int count = cv::connectedComponentsWithStats(out.skin, out.labels, stats, centroids, 8, CV_32S);
+  const int min_area = std::max(1, static_cast<int>(options_.min_area * bgr.total()));
+  for (int label = 1; label < count; ++label) {
+    SkinRegion region;
+    region.label = label;
+    region.area = stats.at<int>(label, cv::CC_STAT_AREA);
+    if (region.area < min_area) continue;
+    region.box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
+                          stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+    region.centroid = cv::Point2d(centroids.at<double>(label, 0), centroids.at<double>(label, 1));
+    int in_faces = 0;
+    for (const cv::Rect& face : faces_) {
+      const cv::Rect overlap = face & region.box;
+      if (overlap.area() > 0) in_faces += cv::countNonZero(out.labels(overlap) == label);
+    }
+    region.face_overlap = std::min(1.0, static_cast<double>(in_faces) / region.area);
+    out.regions.push_back(region);
+  }
+  std::sort(out.regions.begin(), out.regions.end(),
+            [](const SkinRegion& a, const SkinRegion& b) { return a.area != b.area ? a.area > b.area : a.label < b.label; });
+  return out;
+}
+
+void SkinSegmenter::Learn(const cv::Mat& bgr, const cv::Mat& hand) {
+  if (!options_.adapt) return;
+  NPHAND_THROW_CHECK(!bgr.empty() && bgr.type() == CV_8UC3 && hand.type() == CV_8UC1 && hand.size() == bgr.size(),
+                     "skin: learning needs a BGR frame and a hand mask of its size");
+  cv::Mat ycrcb;
+  cv::cvtColor(bgr, ycrcb, cv::COLOR_BGR2YCrCb);
+  // The hand's inside (its edges mix with the background) against everything not near it.
+  cv::Mat inner, near;
+  cv::erode(hand, inner, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
+  cv::dilate(hand, near, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(15, 15)));
+  if (cv::countNonZero(inner) < 50) return;
+  const int channels[] = {1, 2};
+  const int sizes[] = {options_.bins, options_.bins};
+  const float range[] = {0.0f, 256.0f};
+  const float* ranges[] = {range, range};
+  cv::Mat hand_now, rest_now;
+  cv::calcHist(&ycrcb, 1, channels, inner, hand_now, 2, sizes, ranges);
+  cv::calcHist(&ycrcb, 1, channels, near == 0, rest_now, 2, sizes, ranges);
+  const double hand_sum = cv::sum(hand_now)[0], rest_sum = cv::sum(rest_now)[0];
+  if (hand_sum <= 0.0 || rest_sum <= 0.0) return;
+  hand_now /= hand_sum;
+  rest_now /= rest_sum;
+  const double rate = learned_ == 0 ? 1.0 : options_.learn_rate;
+  hand_hist_ = (1.0 - rate) * hand_hist_ + rate * hand_now;
+  rest_hist_ = (1.0 - rate) * rest_hist_ + rate * rest_now;
+  ++learned_;
+  RebuildLookup();
+}
+
+}  // namespace nphand

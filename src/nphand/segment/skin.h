@@ -1,0 +1,88 @@
+// Skin segmentation of camera frames: which pixels are skin, which connected regions they
+// form, which of those may be the hand. A fixed colour model in YCrCb chroma to start, then
+// adapted to the tracked hand's own colours (a hand-against-rest histogram learned from
+// confident frames, updated slowly); morphological clean-up; connected components; faces
+// found by OpenCV's Haar cascade (Debian's opencv-data) and their skin set aside.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace nphand {
+
+// Debian's opencv-data frontal face cascade.
+inline constexpr const char* kDefaultFaceCascade = "/usr/share/opencv4/haarcascades/haarcascade_frontalface_default.xml";
+
+struct SkinOptions {
+  // The fixed model: a box in OpenCV's 8-bit YCrCb (Chai and Ngan's Cr 133..173, Cb 77..127)
+  // above a floor of luma, below which chroma is mostly noise.
+  int cr_min = 133, cr_max = 173, cb_min = 77, cb_max = 127, y_min = 30;
+  // Adaptation: after Learn, a pixel is skin if it is in the box and P(hand | Cr, Cb) >=
+  // keep, or anywhere if P >= add; P compares the hand's chroma histogram with the rest of
+  // the frame's. Each Learn moves the histograms by learn_rate towards the new frame's.
+  bool adapt = true;
+  double learn_rate = 0.1;
+  double keep = 0.25;
+  double add = 0.8;
+  int bins = 32;                // per chroma axis
+  int open_px = 3;              // opening removes specks (0: none)
+  int close_px = 5;             // closing fills cracks; holes wider than this stay (the object's)
+  double min_area = 0.0003;     // smallest region, as a fraction of the frame (fingertips past an object count)
+  // Faces: the cascade's file ("" finds none), run every face_interval frames on a frame
+  // halved until it is at most 320 pixels wide; skin regions mostly inside a face are not
+  // hand candidates.
+  std::string face_cascade = kDefaultFaceCascade;
+  int face_interval = 10;
+  bool Check(std::string* why) const;
+};
+
+struct SkinRegion {
+  int label = 0;              // in SkinSegmentation::labels
+  cv::Rect box;
+  int area = 0;               // pixels
+  cv::Point2d centroid;
+  double face_overlap = 0.0;  // the share of its pixels inside a detected face
+};
+
+struct SkinSegmentation {
+  cv::Mat skin;                     // CV_8UC1, 255 = skin (cleaned)
+  cv::Mat labels;                   // CV_32SC1, connected regions of `skin` (0: none)
+  std::vector<SkinRegion> regions;  // at least min_area, largest first
+  std::vector<cv::Rect> faces;      // the faces in view (the last detection's)
+  // The pixels of one region within its box (CV_8UC1, 255 = the region).
+  cv::Mat RegionMask(const SkinRegion& region) const;
+};
+
+class SkinSegmenter {
+ public:
+  // Throws nphand::Error for invalid options or a face cascade that cannot be loaded.
+  explicit SkinSegmenter(const SkinOptions& options = {});
+
+  // Throws nphand::Error unless `bgr` is a non-empty 8-bit 3-channel image.
+  SkinSegmentation Segment(const cv::Mat& bgr);
+
+  // Learns the hand's colours from a confidently estimated frame: `hand` (CV_8UC1 of the
+  // frame's size, non-zero = the hand's pixels) against the rest of the frame.
+  void Learn(const cv::Mat& bgr, const cv::Mat& hand);
+  bool adapted() const { return learned_ > 0; }
+  // Forgets what was learned and the faces (a new video).
+  void Reset();
+
+ private:
+  void RebuildLookup();
+
+  SkinOptions options_;
+  cv::Mat lookup_;                 // CV_8UC1, 256 x 256 over (Cr, Cb): 255 = skin
+  cv::Mat hand_hist_, rest_hist_;  // CV_32FC1, bins x bins, each summing to 1
+  int learned_ = 0;
+  int frames_ = 0;
+  std::vector<cv::Rect> faces_;
+  struct FaceDetector;
+  std::shared_ptr<FaceDetector> detector_;
+};
+
+}  // namespace nphand

@@ -1,0 +1,92 @@
+#include "nphand/segment/forearm.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "nphand/features/crop.h"
+#include "nphand/segment/skin.h"
+#include "nphand/sequence/sequence.h"
+#include "testing/testing.h"
+
+namespace nphand {
+namespace {
+
+double IoU(const cv::Mat& a, const cv::Mat& b) {
+  const int both = cv::countNonZero(a & b), either = cv::countNonZero(a | b);
+  return either == 0 ? 1.0 : static_cast<double>(both) / either;
+}
+
+int Border(const cv::Rect& box, const cv::Size& frame) {
+  return (box.x == 0 ? 1 : 0) | (box.y == 0 ? 2 : 0) | (box.x + box.width == frame.width ? 4 : 0) |
+         (box.y + box.height == frame.height ? 8 : 0);
+}
+
+// The segmented hand's crop (roll-normalised, as the descriptor sees it) after the cut.
+cv::Mat CutCrop(const cv::Mat& rgb, bool* cut) {
+  SkinOptions options;
+  options.face_cascade.clear();
+  SkinSegmenter segmenter(options);
+  const SkinSegmentation s = segmenter.Segment(rgb);
+  if (s.regions.empty()) return {};
+  const SkinRegion& region = s.regions[0];
+  const ForearmCut c = CutForearm(s.RegionMask(region), Border(region.box, rgb.size()));
+  *cut = c.cut;
+  const std::optional<HandCrop> crop = CropHand(c.hand, {64, 0.1, true});
+  return crop.has_value() ? cv::Mat(crop->image > 0.5f) : cv::Mat();
+}
+
+TEST(ForearmTest, CutArmsGiveTheCropOfTheHandAlone) {
+  std::vector<double> ious;
+  int cut_with = 0, cut_without = 0, frames = 0;
+  for (uint64_t seed = 1; seed <= 6; ++seed) {
+    SequenceOptions options;
+    options.frames = 8;
+    options.width = 320;
+    options.height = 240;
+    options.distance_m = 0.4;
+    options.seed = testing::kTestSeed + seed;
+    options.forearm = ForearmKind::kBare;
+    Sequence with_arm(testing::RightHand(), options);
+    options.forearm = ForearmKind::kNone;
+    Sequence without(testing::RightHand(), options);
+    for (int i = 0; i < options.frames; i += 3) {
+      bool a = false, b = false;
+      const cv::Mat crop_arm = CutCrop(with_arm.Render(i).rgb, &a);
+      const cv::Mat crop_hand = CutCrop(without.Render(i).rgb, &b);
+      ASSERT_FALSE(crop_arm.empty());
+      ASSERT_FALSE(crop_hand.empty());
+      ious.push_back(IoU(crop_arm, crop_hand));
+      cut_with += a;
+      cut_without += b;
+      ++frames;
+    }
+  }
+  std::sort(ious.begin(), ious.end());
+  const double median = ious[ious.size() / 2];
+  EXPECT_GE(median, 0.9) << "lowest " << ious.front();
+  EXPECT_GE(cut_with, frames * 8 / 10);
+  EXPECT_LE(cut_without, frames / 5);
+}
+
+TEST(ForearmTest, ARegionWithoutAnArmIsLeftWhole) {
+  cv::Mat disc = cv::Mat::zeros(200, 200, CV_8UC1);
+  cv::circle(disc, cv::Point(100, 100), 60, cv::Scalar(255), cv::FILLED);
+  const ForearmCut c = CutForearm(disc, 0);
+  EXPECT_FALSE(c.cut);
+  EXPECT_EQ(cv::countNonZero(c.hand != disc), 0);
+  // A paddle: a wide blade on a long handle entering from the bottom edge is cut at the neck.
+  cv::Mat paddle = cv::Mat::zeros(300, 200, CV_8UC1);
+  cv::ellipse(paddle, cv::Point(100, 90), cv::Size(60, 80), 0, 0, 360, cv::Scalar(255), cv::FILLED);
+  cv::rectangle(paddle, cv::Rect(75, 150, 50, 150), cv::Scalar(255), cv::FILLED);
+  const ForearmCut p = CutForearm(paddle, 8);
+  ASSERT_TRUE(p.cut);
+  EXPECT_GT(p.wrist.y, 150);
+  EXPECT_LT(p.wrist.y, 215);
+  EXPECT_NEAR(p.wrist_width, 50, 4);
+  EXPECT_GT(p.arm_direction.y, 0.9);
+  EXPECT_EQ(cv::countNonZero(p.hand(cv::Rect(0, 230, 200, 70))), 0);
+  testing::ExpectError([] { CutForearm(cv::Mat(4, 4, CV_32FC1), 0); }, "8-bit");
+}
+
+}  // namespace
+}  // namespace nphand

@@ -1,0 +1,114 @@
+#include "nphand/segment/skin.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "nphand/sequence/sequence.h"
+#include "testing/testing.h"
+
+namespace nphand {
+namespace {
+
+double IoU(const cv::Mat& a, const cv::Mat& b) {
+  const int both = cv::countNonZero(a & b), either = cv::countNonZero(a | b);
+  return either == 0 ? 1.0 : static_cast<double>(both) / either;
+}
+
+// Every skin region as a frame-sized mask (an object can split the hand into pieces).
+cv::Mat Regions(const SkinSegmentation& segmentation) {
+  cv::Mat mask = cv::Mat::zeros(segmentation.skin.size(), CV_8UC1);
+  for (const SkinRegion& region : segmentation.regions) mask |= segmentation.labels == region.label;
+  return mask;
+}
+
+SkinOptions NoFaces() {
+  SkinOptions options;
+  options.face_cascade.clear();
+  return options;
+}
+
+TEST(SkinTest, RenderedHandsOfEveryToneOnEveryBackgroundMatchTheirLabels) {
+  SkinSegmenter segmenter(NoFaces());
+  int frames = 0;
+  for (const SkinTone& tone : SkinTones()) {
+    for (const std::string& background : BackgroundKindNames()) {
+      SequenceOptions options;
+      options.frames = 10;
+      options.width = 320;
+      options.height = 240;
+      options.skin = tone.name;
+      options.background = BackgroundKindFromString(background);
+      options.forearm = ForearmKind::kNone;
+      options.distance_m = 0.3;
+      options.seed = testing::kTestSeed + frames;
+      Sequence sequence(testing::RightHand(), options);
+      for (int i : {1, 8}) {
+        const SequenceFrame frame = sequence.Render(i);
+        const cv::Mat truth = frame.labels == static_cast<int>(PixelLabel::kHand);
+        const double iou = IoU(Regions(segmenter.Segment(frame.rgb)), truth);
+        EXPECT_GE(iou, 0.95) << tone.name << " on " << background << ", frame " << i << ", grasp " << sequence.grasp();
+        ++frames;
+      }
+    }
+  }
+}
+
+TEST(SkinTest, AdaptationFindsAHandTheFixedModelMisses) {
+  // A reddish tone under warm light: its chroma lies outside the fixed box (Cr > 173).
+  SequenceOptions options;
+  options.frames = 10;
+  options.width = 320;
+  options.height = 240;
+  options.forearm = ForearmKind::kNone;
+  options.distance_m = 0.3;
+  options.seed = testing::kTestSeed;
+  Sequence sequence(testing::RightHand(), options);
+  SequenceFrame frame = sequence.Render(3);
+  const cv::Mat truth = frame.labels == static_cast<int>(PixelLabel::kHand);
+  // Recolour the hand's pixels: keep the shading, move the chroma.
+  cv::Mat ycrcb;
+  cv::cvtColor(frame.rgb, ycrcb, cv::COLOR_BGR2YCrCb);
+  for (int y = 0; y < ycrcb.rows; ++y) {
+    for (int x = 0; x < ycrcb.cols; ++x) {
+      if (truth.at<uint8_t>(y, x) != 0) ycrcb.at<cv::Vec3b>(y, x) = cv::Vec3b(ycrcb.at<cv::Vec3b>(y, x)[0], 182, 112);
+    }
+  }
+  cv::cvtColor(ycrcb, frame.rgb, cv::COLOR_YCrCb2BGR);
+  SkinSegmenter segmenter(NoFaces());
+  EXPECT_LT(IoU(Regions(segmenter.Segment(frame.rgb)), truth), 0.5);
+  segmenter.Learn(frame.rgb, truth);
+  EXPECT_TRUE(segmenter.adapted());
+  EXPECT_GE(IoU(Regions(segmenter.Segment(frame.rgb)), truth), 0.95);
+  segmenter.Reset();
+  EXPECT_FALSE(segmenter.adapted());
+}
+
+TEST(SkinTest, AFrameWithoutSkinHasNoRegionAndAFaceIsMarked) {
+  SkinSegmenter segmenter(NoFaces());
+  const cv::Mat wall = MakeBackground(BackgroundKind::kClutter, cv::Size(320, 240), 7);
+  EXPECT_TRUE(segmenter.Segment(wall).regions.empty());
+
+  cv::Mat with_face = wall.clone();
+  DrawFace(SkinToneByName("medium").bgr, cv::Point(160, 120), 150, &with_face);
+  const SkinSegmentation found = segmenter.Segment(with_face);
+  ASSERT_EQ(found.regions.size(), 1u);
+  EXPECT_GT(found.regions[0].area, 10000);
+}
+
+TEST(SkinTest, BadInputIsRefused) {
+  SkinSegmenter segmenter(NoFaces());
+  testing::ExpectError([&] { segmenter.Segment(cv::Mat()); }, "8-bit BGR");
+  testing::ExpectError([&] { segmenter.Segment(cv::Mat(10, 10, CV_8UC1)); }, "8-bit BGR");
+  SkinOptions options = NoFaces();
+  options.cr_min = 200;
+  testing::ExpectError([&] { SkinSegmenter bad(options); }, "min <= max");
+  options = SkinOptions{};
+  options.face_cascade = "/nonexistent/cascade.xml";
+  testing::ExpectError([&] { SkinSegmenter bad(options); }, "no face cascade");
+  // The default cascade loads (Debian's opencv-data is a set-up dependency).
+  SkinSegmenter with_faces;
+  EXPECT_TRUE(with_faces.Segment(MakeBackground(BackgroundKind::kPlain, cv::Size(64, 48), 1)).faces.empty());
+}
+
+}  // namespace
+}  // namespace nphand
