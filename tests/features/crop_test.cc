@@ -67,5 +67,48 @@ TEST(CropTest, RollNormalisationUndoesInPlaneRotation) {
   }
 }
 
+TEST(CropTest, CropFromImageMapsSourcePixelsOntoTheCrop) {
+  cv::Mat mask(150, 200, CV_8UC1, cv::Scalar(0));
+  cv::rectangle(mask, cv::Rect(60, 30, 20, 90), cv::Scalar(255), cv::FILLED);
+  cv::circle(mask, {70, 35}, 18, cv::Scalar(255), cv::FILLED);
+  // Marked source points: the knob's centre and the bar's far end.
+  const std::vector<cv::Point2d> marks = {{70, 35}, {70, 115}};
+  for (double degrees : {0.0, 35.0, -100.0}) {
+    const cv::Mat turned = RotateMask(mask, degrees * std::numbers::pi / 180.0);
+    for (bool normalize : {false, true}) {
+      const CropOptions options{.size = 64, .margin = 0.1, .normalize_roll = normalize};
+      const HandCrop crop = *CropHand(turned, options);
+      // The turned mask's marks, found by turning them as RotateMask turns pixels.
+      const cv::Mat turn = cv::getRotationMatrix2D(cv::Point2f(100, 75), degrees, 1.0);
+      const int side = turned.cols;
+      for (const cv::Point2d& p : marks) {
+        const cv::Point2d q(turn.at<double>(0, 0) * p.x + turn.at<double>(0, 1) * p.y + turn.at<double>(0, 2) + 0.5 * (side - 200),
+                            turn.at<double>(1, 0) * p.x + turn.at<double>(1, 1) * p.y + turn.at<double>(1, 2) + 0.5 * (side - 150));
+        const cv::Matx23d& a = crop.crop_from_image;
+        const cv::Point2d c(a(0, 0) * q.x + a(0, 1) * q.y + a(0, 2), a(1, 0) * q.x + a(1, 1) * q.y + a(1, 2));
+        ASSERT_GE(c.x, 0);
+        ASSERT_GE(c.y, 0);
+        ASSERT_LT(c.x, 64);
+        ASSERT_LT(c.y, 64);
+        EXPECT_GT(crop.image.at<float>(static_cast<int>(c.y), static_cast<int>(c.x)), 0.5f) << degrees << " " << normalize;
+      }
+      if (normalize) {
+        const cv::Matx23d& a = crop.crop_from_image;
+        EXPECT_GT(crop.roll_skewness, 0.1);
+        const cv::Mat before = crop.image.clone();
+        const HandCrop half = HalfTurn(crop);
+        EXPECT_EQ(cv::norm(before, crop.image, cv::NORM_INF), 0.0);
+        EXPECT_NEAR(std::abs(std::remainder(half.roll - crop.roll, 2 * std::numbers::pi)), std::numbers::pi, 1e-9);
+        EXPECT_NEAR(half.image.at<float>(63 - 10, 63 - 32), crop.image.at<float>(10, 32), 1e-6f);
+        EXPECT_NEAR(half.crop_from_image(0, 2) + a(0, 2), 63.0, 1e-9);
+      }
+    }
+  }
+  // A disc's ends look alike.
+  cv::Mat disc(100, 100, CV_8UC1, cv::Scalar(0));
+  cv::circle(disc, {50, 50}, 30, cv::Scalar(255), cv::FILLED);
+  EXPECT_LT(CropHand(disc, {64, 0.1, true})->roll_skewness, 0.02);
+}
+
 }  // namespace
 }  // namespace nphand

@@ -76,7 +76,7 @@ TEST_F(LshIndexTest, MoreProbesNeverLoseNeighbours) {
   LshOptions options;
   options.tables = 2;
   options.hashes = 8;
-  options.bucket_width = 0.15;
+  options.bucket_width = 0.25;
   options.probes = 1;
   const double one = Recall(LshIndex(DatabaseDescriptors(db()), options, nullptr), 10, 0, 3);
   options.probes = 30;

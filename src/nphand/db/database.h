@@ -26,7 +26,9 @@
 
 namespace nphand {
 
-inline constexpr uint32_t kDatabaseVersion = 1;
+// 2: a roll-normalised mask is turned about its own box centre, bilinearly (1 turned it
+// about the image centre by nearest neighbour, so its descriptor hung on where the hand sat).
+inline constexpr uint32_t kDatabaseVersion = 2;
 inline constexpr int kCropBitsSide = 64;  // the stored hand crop: 64 x 64 bits
 
 // One record, packed: metadata, then the pose, angles, keypoints, HOG and the crop's bits.

@@ -26,6 +26,13 @@ struct HandCrop {
   cv::Rect window;  // the square of the source image that was resampled (may extend past it);
                     // with normalize_roll, of the turned mask
   double roll = 0.0;  // radians the mask was turned counter-clockwise (as displayed) first
+  // How sure the turn is of its direction: the third central moment along the principal
+  // axis over the second's 3/2 power (the silhouette's skewness, >= 0). Near 0 the ends look
+  // alike and the turn may be half a revolution off. 0 without roll normalisation.
+  double roll_skewness = 0.0;
+  // Source pixel (x, y) (OpenCV's convention: integers at pixel centres) to crop pixel:
+  // the turn, the window and the resampling in one affine map.
+  cv::Matx23d crop_from_image = cv::Matx23d(1, 0, 0, 0, 1, 0);
 };
 
 // `mask` turned counter-clockwise (as displayed) by `angle` radians about its centre, on a
@@ -33,11 +40,16 @@ struct HandCrop {
 cv::Mat RotateMask(const cv::Mat& mask, double angle);
 
 // The counter-clockwise turn that makes the mask's principal axis vertical with its third
-// moment along that axis negative (mass towards the top); 0 for an empty mask.
-double PrincipalRoll(const cv::Mat& mask);
+// moment along that axis negative (mass towards the top); 0 for an empty mask. If
+// `skewness` is not null it receives the normalised third moment's magnitude along the axis.
+double PrincipalRoll(const cv::Mat& mask, double* skewness = nullptr);
 
 // The crop of the non-zero pixels of `mask` (CV_8UC1); std::nullopt when the mask has none
 // ("no hand"). Throws nphand::Error for a mask of another type or invalid options.
 std::optional<HandCrop> CropHand(const cv::Mat& mask, const CropOptions& options = {});
+
+// The crop turned by half a revolution (roll + pi): the other reading of a silhouette whose
+// ends look alike (small roll_skewness).
+HandCrop HalfTurn(const HandCrop& crop);
 
 }  // namespace nphand

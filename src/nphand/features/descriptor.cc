@@ -73,7 +73,15 @@ std::optional<Descriptor> Describe(const cv::Mat& mask, const DescriptorConfig& 
   NPHAND_THROW_CHECK(config.Check(&why), "descriptor: ", why);
   const std::optional<HandCrop> crop = CropHand(mask, config.Crop());
   if (!crop.has_value()) return std::nullopt;
-  return Descriptor{config, ComputeHog(crop->image, config.hog), crop->roll};
+  return DescribeCrop(*crop, config);
+}
+
+Descriptor DescribeCrop(const HandCrop& crop, const DescriptorConfig& config) {
+  NPHAND_THROW_CHECK(crop.image.type() == CV_32FC1 && crop.image.rows == config.crop_size &&
+                         crop.image.cols == config.crop_size,
+                     "descriptor: a crop of ", crop.image.cols, "x", crop.image.rows, " is not the config's ",
+                     config.crop_size, " pixels");
+  return Descriptor{config, ComputeHog(crop.image, config.hog), crop.roll, crop.roll_skewness};
 }
 
 DescriptorMatrix::DescriptorMatrix(const DescriptorConfig& config, size_t rows)

@@ -44,6 +44,7 @@ struct Descriptor {
   DescriptorConfig config;    // how it was computed
   std::vector<float> values;  // config.Dimension() values
   double roll = 0.0;          // radians the mask was turned before it was described
+  double roll_skewness = 0.0; // HandCrop::roll_skewness: how sure the turn's direction is
 };
 
 // Descriptors of one config, one per row, contiguous (row-major), as every index backend
@@ -75,5 +76,8 @@ void CheckSameDescriptor(const DescriptorConfig& expected, const DescriptorConfi
 // The descriptor of the non-zero pixels of `mask` (CV_8UC1); std::nullopt when it has none
 // ("no hand"). Throws nphand::Error for an invalid config or mask.
 std::optional<Descriptor> Describe(const cv::Mat& mask, const DescriptorConfig& config);
+// The same from a crop already made with config.Crop() (the estimator keeps the crop to
+// place keypoints, and describes its half turn too).
+Descriptor DescribeCrop(const HandCrop& crop, const DescriptorConfig& config);
 
 }  // namespace nphand

@@ -35,41 +35,46 @@ int EndTouches(const std::vector<cv::Point>& points, const std::vector<double>& 
 bool ForearmCutOptions::Check(std::string* why) const {
   if (!(widen_ratio > 1.0 && widen_ratio < 5.0) || !(min_arm_width > 0.0 && min_arm_width < 1.0) ||
       !(min_arm_length >= 0.0 && min_arm_length < 10.0) || !(min_arm_length_at_edge >= 0.0 && min_arm_length_at_edge < 10.0)) {
-    *why = "forearm cut needs widen ratio in (1, 5), arm width in (0, 1) and arm length in [0, 10)";
+    *why = "forearm cut needs widen ratio in (1, 5), arm width in (0, 1) and arm lengths in [0, 10)";
     return false;
   }
   return true;
 }
 
-ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions& options) {
-  std::string why;
-  NPHAND_THROW_CHECK(options.Check(&why), "forearm: ", why);
-  NPHAND_THROW_CHECK(!region.empty() && region.type() == CV_8UC1, "forearm: a region must be an 8-bit single-channel mask");
-  ForearmCut result;
-  result.hand = region != 0;
-  std::vector<cv::Point> points;
-  cv::findNonZero(result.hand, points);
-  if (points.size() < 50) return result;
+namespace {
 
-  const cv::Moments m = cv::moments(result.hand, true);
-  const cv::Point2d centre(m.m10 / m.m00, m.m01 / m.m00);
-  const double angle = 0.5 * std::atan2(2.0 * m.mu11, m.mu20 - m.mu02);
-  const cv::Point2d axis(std::cos(angle), std::sin(angle)), across(-std::sin(angle), std::cos(angle));
+// One reading of the region along an axis: the width profile, and where the wrist is.
+struct Reading {
+  int direction = 0;          // +1: the arm is at the low end of the axis; -1: the high end; 0: no arm
+  double cut_t = 0.0;         // axis coordinate of the cut
+  double wrist_width = 0.0;
+  cv::Point2d wrist;          // the cut's centre
+  cv::Point2d centre, axis;   // the axis: through `centre` along `axis` (unit)
+  std::vector<double> t;      // each point's axis coordinate
+};
 
-  std::vector<double> t(points.size()), s(points.size());
+// The region's points read along `axis` through `centre`.
+Reading Read(const std::vector<cv::Point>& points, cv::Point2d centre, cv::Point2d axis, int border,
+             const cv::Size& size, const ForearmCutOptions& options) {
+  Reading r;
+  r.centre = centre;
+  r.axis = axis;
+  const cv::Point2d across(-axis.y, axis.x);
+  r.t.resize(points.size());
+  std::vector<double> s(points.size());
   double t_min = 1e300, t_max = -1e300;
   for (size_t i = 0; i < points.size(); ++i) {
     const cv::Point2d d = cv::Point2d(points[i]) - centre;
-    t[i] = d.dot(axis);
+    r.t[i] = d.dot(axis);
     s[i] = d.dot(across);
-    t_min = std::min(t_min, t[i]);
-    t_max = std::max(t_max, t[i]);
+    t_min = std::min(t_min, r.t[i]);
+    t_max = std::max(t_max, r.t[i]);
   }
   const int slices = static_cast<int>(std::floor(t_max - t_min)) + 1;
-  if (slices < 8) return result;
+  if (slices < 8) return r;
   std::vector<double> low(slices, 1e300), high(slices, -1e300);
   for (size_t i = 0; i < points.size(); ++i) {
-    const int k = std::min(slices - 1, static_cast<int>(t[i] - t_min));
+    const int k = std::min(slices - 1, static_cast<int>(r.t[i] - t_min));
     low[k] = std::min(low[k], s[i]);
     high[k] = std::max(high[k], s[i]);
   }
@@ -85,13 +90,12 @@ ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions
     width[k] = sum / n;
   }
   const double widest = *std::max_element(width.begin(), width.end());
-
   const double reach = 0.05 * slices;
-  const int touch_low = EndTouches(points, t, t_min, t_min + reach, border, region.size());
-  const int touch_high = EndTouches(points, t, t_max - reach, t_max, border, region.size());
-  auto touches_edge = [&](int direction) { return (direction > 0 ? touch_low : touch_high) > 0; };
+  const int touch_low = EndTouches(points, r.t, t_min, t_min + reach, border, size);
+  const int touch_high = EndTouches(points, r.t, t_max - reach, t_max, border, size);
 
-  // From one end (direction +1: from t_min), the narrowest point before the widening, or -1.
+  // From one end (direction +1: from t_min), the narrow stretch's end before the widening
+  // (steps from that end), or -1.
   auto find_wrist = [&](int direction, double* wrist_width) {
     auto index = [&](int step) { return direction > 0 ? step : slices - 1 - step; };
     // Skip the end's cap, where the width still grows (a rounded end, or an arm that leaves
@@ -102,7 +106,7 @@ ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions
     int at = -1;
     for (int step = first; step < slices; ++step) {
       const int k = index(step);
-      // The narrow stretch's end nearest the hand: an arm of even width is cut where it ends.
+      // An arm of even width is cut where its narrow stretch ends.
       if (width[k] < narrowest) {
         narrowest = width[k];
         at = step;
@@ -112,7 +116,8 @@ ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions
       if (step > first && width[k] > options.widen_ratio * narrowest) {
         *wrist_width = narrowest;
         // An arm: long enough before the cut and not as thin as a finger.
-        const double length = at >= 0 && touches_edge(direction) ? options.min_arm_length_at_edge : options.min_arm_length;
+        const bool edge = (direction > 0 ? touch_low : touch_high) > 0;
+        const double length = edge ? options.min_arm_length_at_edge : options.min_arm_length;
         if (at >= length * narrowest && narrowest >= options.min_arm_width * widest) return at;
         return -1;
       }
@@ -122,25 +127,48 @@ ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions
   double width_low = 0.0, width_high = 0.0;
   const int from_low = find_wrist(+1, &width_low);
   const int from_high = find_wrist(-1, &width_high);
-  int direction = 0;
   if (from_low >= 0 && from_high >= 0) {
     // Both ends could be an arm: the one entering from the frame's edge, else the longer run.
     if (touch_low != touch_high) {
-      direction = touch_low > touch_high ? +1 : -1;
+      r.direction = touch_low > touch_high ? +1 : -1;
     } else {
-      direction = from_low >= from_high ? +1 : -1;
+      r.direction = from_low >= from_high ? +1 : -1;
     }
   } else if (from_low >= 0) {
-    direction = +1;
+    r.direction = +1;
   } else if (from_high >= 0) {
-    direction = -1;
+    r.direction = -1;
   }
-  if (direction == 0) return result;
+  if (r.direction == 0) return r;
+  const int step = r.direction > 0 ? from_low : from_high;
+  r.wrist_width = r.direction > 0 ? width_low : width_high;
+  r.cut_t = r.direction > 0 ? t_min + step + 0.5 : t_max - step - 0.5;
+  const int k = std::clamp(static_cast<int>(r.cut_t - t_min), 0, slices - 1);
+  r.wrist = centre + axis * r.cut_t + across * (0.5 * (low[k] + high[k]));
+  return r;
+}
 
-  const int step = direction > 0 ? from_low : from_high;
-  const double cut_t = direction > 0 ? t_min + step + 0.5 : t_max - step - 0.5;
+bool OnArmSide(const Reading& r, double t) { return r.direction > 0 ? t < r.cut_t : t > r.cut_t; }
+
+}  // namespace
+
+ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions& options) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "forearm: ", why);
+  NPHAND_THROW_CHECK(!region.empty() && region.type() == CV_8UC1, "forearm: a region must be an 8-bit single-channel mask");
+  ForearmCut result;
+  result.hand = region != 0;
+  std::vector<cv::Point> points;
+  cv::findNonZero(result.hand, points);
+  if (points.size() < 50) return result;
+
+  const cv::Moments m = cv::moments(result.hand, true);
+  const double angle = 0.5 * std::atan2(2.0 * m.mu11, m.mu20 - m.mu02);
+  const Reading reading = Read(points, cv::Point2d(m.m10 / m.m00, m.m01 / m.m00), cv::Point2d(std::cos(angle), std::sin(angle)),
+                               border, region.size(), options);
+  if (reading.direction == 0) return result;
   for (size_t i = 0; i < points.size(); ++i) {
-    if ((direction > 0 && t[i] < cut_t) || (direction < 0 && t[i] > cut_t)) result.hand.at<uint8_t>(points[i]) = 0;
+    if (OnArmSide(reading, reading.t[i])) result.hand.at<uint8_t>(points[i]) = 0;
   }
   // The cut may leave crumbs of the arm's edge: keep the largest piece.
   cv::Mat labels, stats, centroids;
@@ -153,10 +181,9 @@ ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions
     result.hand = labels == best;
   }
   result.cut = true;
-  result.wrist_width = direction > 0 ? width_low : width_high;
-  const int k = direction > 0 ? step : slices - 1 - step;
-  result.wrist = centre + axis * cut_t + across * (0.5 * (low[k] + high[k]));
-  result.arm_direction = direction > 0 ? -axis : axis;
+  result.wrist_width = reading.wrist_width;
+  result.wrist = reading.wrist;
+  result.arm_direction = reading.direction > 0 ? -reading.axis : reading.axis;
   return result;
 }
 

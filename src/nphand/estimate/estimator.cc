@@ -1,0 +1,505 @@
+#include "nphand/estimate/estimator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include <opencv2/imgproc.hpp>
+
+#include "nphand/features/crop.h"
+#include "nphand/features/descriptor.h"
+#include "nphand/scene/viewpoint.h"
+#include "nphand/util/check.h"
+
+namespace nphand {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Ms(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double, std::milli>(to - from).count();
+}
+
+// A hand region together with the pieces an object splits off it: skin regions (not faces)
+// whose boxes meet the region's box grown by 30 % of its longer side.
+cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, cv::Rect* box) {
+  const int grow = static_cast<int>(0.3 * std::max(seed.box.width, seed.box.height));
+  const cv::Rect reach(seed.box.x - grow, seed.box.y - grow, seed.box.width + 2 * grow, seed.box.height + 2 * grow);
+  cv::Mat mask = s.labels == seed.label;
+  *box = seed.box;
+  for (const SkinRegion& r : s.regions) {
+    if (r.label == seed.label || r.face_overlap >= 0.5 || (r.box & reach).area() == 0) continue;
+    mask |= s.labels == r.label;
+    *box |= r.box;
+  }
+  return mask;
+}
+
+int Border(const cv::Rect& box, const cv::Size& frame) {
+  return (box.x == 0 ? 1 : 0) | (box.y == 0 ? 2 : 0) | (box.x + box.width == frame.width ? 4 : 0) |
+         (box.y + box.height == frame.height ? 8 : 0);
+}
+
+Eigen::Vector2d Apply(const cv::Matx23d& a, const Eigen::Vector2d& p) {
+  return Eigen::Vector2d(a(0, 0) * p.x() + a(0, 1) * p.y() + a(0, 2), a(1, 0) * p.x() + a(1, 1) * p.y() + a(1, 2));
+}
+
+cv::Matx23d Invert(const cv::Matx23d& a) {
+  cv::Matx23d inverse;
+  cv::invertAffineTransform(a, inverse);
+  return inverse;
+}
+
+double Scale(const cv::Matx23d& a) { return std::sqrt(std::abs(a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0))); }
+
+void MirrorResult(int width, FrameResult* r) {
+  r->pose = MirrorPose(r->pose);
+  for (Hypothesis& h : r->top) h.pose = MirrorPose(h.pose);
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    r->keypoints_2d[k].x() = width - r->keypoints_2d[k].x();
+    r->keypoints_hand[k].x() = -r->keypoints_hand[k].x();
+    r->keypoints_camera[k].x() = -r->keypoints_camera[k].x();
+  }
+  r->box.x = width - r->box.x - r->box.width;
+}
+
+}  // namespace
+
+std::string ToString(ObservationWeight weight) { return weight == ObservationWeight::kFixed ? "fixed" : "adaptive"; }
+
+std::string ToString(PriorCombination combination) {
+  switch (combination) {
+    case PriorCombination::kNone: return "none";
+    case PriorCombination::kProduct: return "product";
+    case PriorCombination::kSum: return "sum";
+  }
+  return "?";
+}
+
+ObservationWeight ObservationWeightFromString(const std::string& text) {
+  if (text == "fixed") return ObservationWeight::kFixed;
+  if (text == "adaptive") return ObservationWeight::kAdaptive;
+  NPHAND_THROW("unknown observation weight '", text, "' (choose fixed or adaptive)");
+}
+
+PriorCombination PriorCombinationFromString(const std::string& text) {
+  if (text == "none") return PriorCombination::kNone;
+  if (text == "product") return PriorCombination::kProduct;
+  if (text == "sum") return PriorCombination::kSum;
+  NPHAND_THROW("unknown prior combination '", text, "' (choose none, product or sum)");
+}
+
+std::vector<double> CombineWithPrior(const std::vector<PoseX>& poses, const std::vector<double>& observation,
+                                     const std::vector<WeightedPose>& carried, const EstimatorOptions& options,
+                                     bool* prior_used) {
+  NPHAND_CHECK(poses.size() == observation.size(), "poses and weights differ in number");
+  *prior_used = false;
+  std::vector<double> w = observation;
+  if (options.prior == PriorCombination::kNone || carried.empty()) return w;
+  // A Gaussian kernel density over the carried hypotheses.
+  std::vector<double> g(poses.size(), 0.0);
+  const double inv = 1.0 / (2.0 * options.sigma_x * options.sigma_x);
+  double g_sum = 0.0;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    for (const WeightedPose& c : carried) g[i] += c.weight * std::exp(-(poses[i] - c.x).squaredNorm() * inv);
+    g_sum += g[i];
+  }
+  // A prior that gives every hypothesis nothing (the hand jumped) is no prior.
+  if (!(g_sum > 1e-300)) return w;
+  double sum = 0.0;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    w[i] = options.prior == PriorCombination::kProduct ? observation[i] * g[i]
+                                                       : (1.0 - options.prior_share) * observation[i] +
+                                                             options.prior_share * g[i] / g_sum;
+    sum += w[i];
+  }
+  if (!(sum > 1e-300)) return observation;
+  for (double& v : w) v /= sum;
+  *prior_used = true;
+  return w;
+}
+
+std::string ToString(FrameStatus status) {
+  switch (status) {
+    case FrameStatus::kDetected: return "detected";
+    case FrameStatus::kNoSkin: return "no_skin";
+    case FrameStatus::kNotAHand: return "not_a_hand";
+  }
+  return "?";
+}
+
+bool EstimatorOptions::Check(std::string* why) const {
+  if (k < 1 || k > 100000) {
+    *why = "k must be within 1..100000";
+  } else if (!(sigma_y > 0.0 && sigma_y < 10.0) || !(sigma_x > 0.0 && sigma_x < 100.0)) {
+    *why = "sigma_y must be within (0, 10) and sigma_x within (0, 100)";
+  } else if (!(prior_share >= 0.0 && prior_share <= 1.0)) {
+    *why = "the prior's share must be within [0, 1]";
+  } else if (carried < 1 || carried > k || top_n < 1 || top_n > k) {
+    *why = "carried hypotheses and top-N must be within 1..k";
+  } else if (!(roll_ambiguity >= 0.0 && roll_ambiguity < 10.0) || !(max_distance > 0.0 && max_distance < 10.0)) {
+    *why = "roll ambiguity must be within [0, 10) and the largest distance within (0, 10)";
+  } else if (!(focal_px >= 0.0 && focal_px < 1e6) || !(fov_deg > 1.0 && fov_deg < 179.0)) {
+    *why = "the focal length must be >= 0 pixels (0: from the field of view) and the field of view within (1, 179) degrees";
+  } else if (!(hand_length_m >= 0.05 && hand_length_m <= 0.4)) {
+    *why = "the hand length must be within [0.05, 0.4] metres";
+  } else if (learn_interval < 1) {
+    *why = "the learning interval must be at least 1 frame";
+  } else if (!skin.Check(why) || !forearm.Check(why)) {
+    return false;
+  } else {
+    return true;
+  }
+  return false;
+}
+
+Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel& hand, const EstimatorOptions& options)
+    : db_(db), index_(index), hand_(hand), options_(options), segmenter_(options.skin), renderer_(hand) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "estimator: ", why);
+  NPHAND_THROW_CHECK(db.header().value("hand", "") == "right" && hand.handedness() == Handedness::kRight,
+                     "estimator: needs a right-hand database and the right hand model (left hands are mirrored)");
+  NPHAND_THROW_CHECK(db.header().value("hand_asset_sha256", "") == PinnedAssetSha256(Handedness::kRight),
+                     "estimator: the database was rendered from another hand asset");
+  CheckSameDescriptor(db.descriptor(), index.config(), "estimator: the index");
+  NPHAND_THROW_CHECK(index.size() <= db.size(), "estimator: the index holds ", index.size(),
+                     " entries, more than the database's ", db.size(), " (an index of another database?)");
+  const nlohmann::json& render = db.header()["render"];
+  db_intrinsics_ = Intrinsics::FromFieldOfView(render["image_size"].get<int>(), render["image_size"].get<int>(),
+                                               render["fov_deg"].get<double>() * std::numbers::pi / 180.0);
+  db_distance_ = render["distance_m"].get<double>();
+  directions_ = ViewSphereDirections(db.header()["viewpoints"].get<int>());
+  grasps_.resize(kNumGrasps + 1);
+  for (size_t i = 0; i < db.size() && model_hand_length_ == 0.0; ++i) {
+    if (!db.Meta(i).has_hand) continue;
+    const Keypoints3d k = db.Keypoints(i);
+    model_hand_length_ = (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
+  }
+  NPHAND_THROW_CHECK(model_hand_length_ > 0.0, "estimator: the database holds no entry with a hand");
+}
+
+void Estimator::Reset() {
+  carried_.clear();
+  last_centre_.reset();
+  segmenter_.Reset();
+  frame_ = 0;
+  since_learn_ = 0;
+}
+
+const Intrinsics& Estimator::intrinsics_for(cv::Size frame) const {
+  if (frame_intrinsics_.width != frame.width || frame_intrinsics_.height != frame.height) {
+    frame_intrinsics_ = Intrinsics::FromFieldOfView(frame.width, frame.height, options_.fov_deg * std::numbers::pi / 180.0);
+    if (options_.focal_px > 0.0) frame_intrinsics_.fx = frame_intrinsics_.fy = options_.focal_px;
+  }
+  return frame_intrinsics_;
+}
+
+const Grasp& Estimator::GraspOf(int id) {
+  NPHAND_CHECK(id >= 1 && id <= kNumGrasps, "grasp ", id);
+  if (!grasps_[id].has_value()) grasps_[id] = MakeGrasp(hand_, GraspTaxonomy()[id - 1]);
+  return *grasps_[id];
+}
+
+Scene Estimator::EntryScene(uint32_t entry) {
+  const EntryMeta meta = db_.Meta(entry);
+  Scene scene;
+  scene.hand.angles = db_.Angles(entry);
+  scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(directions_[meta.viewpoint]));
+  scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, hand_.bind_centre(), db_distance_);
+  if (meta.with_object) scene.objects = {GraspOf(meta.grasp).object};
+  return scene;
+}
+
+RenderedImages Estimator::RenderEntry(uint32_t entry) {
+  NPHAND_THROW_CHECK(entry < db_.size(), "estimator: no database entry ", entry);
+  RenderOptions options;
+  options.depth = false;
+  return renderer_.Render(EntryScene(entry), db_intrinsics_, options);
+}
+
+FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
+  const Clock::time_point start = Clock::now();
+  FrameResult result;
+  result.frame = frame_++;
+  result.time_s = time_s;
+  const SkinSegmentation skin = segmenter_.Segment(bgr);
+  std::vector<const SkinRegion*> candidates;
+  for (const SkinRegion& r : skin.regions) {
+    if (r.face_overlap < 0.5) candidates.push_back(&r);
+  }
+  // Larger and nearer the last hand first.
+  const double spread = 0.3 * std::hypot(bgr.cols, bgr.rows);
+  auto score = [&](const SkinRegion* r) {
+    double s = r->area;
+    if (last_centre_.has_value()) {
+      const cv::Point2d d = r->centroid - *last_centre_;
+      s *= std::exp(-(d.x * d.x + d.y * d.y) / (2.0 * spread * spread));
+    }
+    return s;
+  };
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [&](const SkinRegion* a, const SkinRegion* b) { return score(a) > score(b); });
+  result.ms.segment = Ms(start, Clock::now());
+  if (candidates.empty()) {
+    result.status = FrameStatus::kNoSkin;
+    result.reason = skin.regions.empty() ? "no skin-coloured region" : "only faces are skin-coloured";
+    carried_.clear();
+    result.ms.total = Ms(start, Clock::now());
+    return result;
+  }
+  // The best region that looks like a hand; a second try if the first does not.
+  for (size_t c = 0; c < std::min<size_t>(2, candidates.size()); ++c) {
+    const Clock::time_point part = Clock::now();
+    cv::Rect box;
+    cv::Mat hand = GatherHand(skin, *candidates[c], &box);
+    bool cut = false;
+    if (options_.cut_forearm) {
+      const ForearmCut forearm = CutForearm(hand(box), Border(box, bgr.size()), options_.forearm);
+      cut = forearm.cut;
+      if (cut) {
+        hand = cv::Mat::zeros(bgr.size(), CV_8UC1);
+        forearm.hand.copyTo(hand(box));
+        box = cv::boundingRect(hand);
+      }
+    }
+    result.ms.segment += Ms(part, Clock::now());
+    const bool left = options_.hand == Handedness::kLeft;
+    cv::Mat query = hand;
+    cv::Rect query_box = box;
+    if (left) {
+      cv::flip(hand, query, 1);
+      query_box.x = bgr.cols - box.x - box.width;
+    }
+    FrameResult attempt = Estimate(query, query_box, bgr.size(), result);
+    attempt.forearm_cut = cut;
+    if (attempt.detected() || c + 1 == std::min<size_t>(2, candidates.size())) {
+      if (left && attempt.detected()) MirrorResult(bgr.cols, &attempt);
+      if (attempt.detected()) {
+        last_centre_ = cv::Point2d(attempt.box.x + 0.5 * attempt.box.width, attempt.box.y + 0.5 * attempt.box.height);
+        if (++since_learn_ >= options_.learn_interval && attempt.confidence >= 0.5) {
+          segmenter_.Learn(bgr, hand);
+          since_learn_ = 0;
+        }
+      }
+      attempt.ms.total = Ms(start, Clock::now());
+      return attempt;
+    }
+  }
+  NPHAND_CHECK(false, "unreachable");
+  return result;
+}
+
+FrameResult Estimator::ProcessMask(const cv::Mat& mask, double time_s) {
+  NPHAND_THROW_CHECK(!mask.empty() && mask.type() == CV_8UC1, "estimator: a hand mask must be a non-empty 8-bit single-channel image");
+  const Clock::time_point start = Clock::now();
+  FrameResult result;
+  result.frame = frame_++;
+  result.time_s = time_s;
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.area() == 0) {
+    result.status = FrameStatus::kNoSkin;
+    result.reason = "the mask is empty";
+    carried_.clear();
+    return result;
+  }
+  const bool left = options_.hand == Handedness::kLeft;
+  cv::Mat query = mask != 0;
+  cv::Rect query_box = box;
+  if (left) {
+    cv::flip(query, query, 1);
+    query_box.x = mask.cols - box.x - box.width;
+  }
+  FrameResult out = Estimate(query, query_box, mask.size(), result);
+  if (left && out.detected()) MirrorResult(mask.cols, &out);
+  out.ms.total = Ms(start, Clock::now());
+  return out;
+}
+
+FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result) {
+  // Describe the hand's pixels within a padded box (turning a whole frame would cost more).
+  Clock::time_point t = Clock::now();
+  const cv::Rect roi = cv::Rect(box.x - 2, box.y - 2, box.width + 4, box.height + 4) & cv::Rect(0, 0, frame.width, frame.height);
+  const DescriptorConfig& config = db_.descriptor();
+  const std::optional<HandCrop> crop = CropHand(hand_mask(roi), config.Crop());
+  NPHAND_CHECK(crop.has_value(), "a non-empty box gave no crop");
+  std::vector<HandCrop> crops = {*crop};
+  if (config.normalize_roll && crop->roll_skewness < options_.roll_ambiguity) crops.push_back(HalfTurn(*crop));
+  std::vector<Descriptor> descriptors;
+  for (const HandCrop& c : crops) descriptors.push_back(DescribeCrop(c, config));
+  result.both_turns = crops.size() == 2;
+  result.ms.describe = Ms(t, Clock::now());
+
+  t = Clock::now();
+  std::vector<Neighbours> found;
+  for (const Descriptor& d : descriptors) found.push_back(index_.Search(d, options_.k));
+  result.ms.search = Ms(t, Clock::now());
+
+  t = Clock::now();
+  struct Candidate {
+    uint32_t entry;
+    int turn_of;  // which crop
+    double distance;
+    double turn;
+    Eigen::Matrix3d rotation;
+    PoseX x;
+    double w = 0.0;
+  };
+  std::vector<Candidate> hyp;
+  for (size_t c = 0; c < found.size(); ++c) {
+    for (size_t i = 0; i < found[c].ids.size(); ++i) {
+      Candidate h;
+      h.entry = found[c].ids[i];
+      h.turn_of = static_cast<int>(c);
+      h.distance = std::sqrt(std::max(0.0f, found[c].distances[i]));
+      const EntryMeta meta = db_.Meta(h.entry);
+      h.turn = config.normalize_roll ? std::remainder(crops[c].roll - meta.roll, 2.0 * std::numbers::pi) : 0.0;
+      const PoseVector pose = db_.Pose(h.entry);
+      Eigen::Matrix3d entry_rotation;
+      for (int r = 0; r < 3; ++r) {
+        for (int col = 0; col < 3; ++col) entry_rotation(r, col) = pose[3 * r + col];
+      }
+      h.rotation = AxisAngle(Eigen::Vector3d::UnitZ(), h.turn) * entry_rotation;
+      for (int r = 0; r < 3; ++r) {
+        for (int col = 0; col < 3; ++col) h.x[3 * r + col] = h.rotation(r, col);
+      }
+      h.x.tail<kNumDofs>() = pose.tail<kNumDofs>();
+      hyp.push_back(std::move(h));
+    }
+  }
+  NPHAND_CHECK(!hyp.empty(), "the index returned no neighbours");
+  double nearest = hyp[0].distance;
+  for (const Candidate& h : hyp) nearest = std::min(nearest, h.distance);
+  result.nearest_distance = nearest;
+  if (nearest > options_.max_distance) {
+    result.status = FrameStatus::kNotAHand;
+    result.reason = "nothing in the database looks like this region (nearest feature distance " +
+                    std::to_string(nearest) + " > " + std::to_string(options_.max_distance) + ")";
+    result.box = box;
+    carried_.clear();
+    result.ms.weigh = Ms(t, Clock::now());
+    return result;
+  }
+
+  // Observation weights, as logarithms until normalised.
+  std::vector<double> log_w(hyp.size());
+  if (options_.observation == ObservationWeight::kFixed) {
+    for (size_t i = 0; i < hyp.size(); ++i) log_w[i] = -hyp[i].distance * hyp[i].distance / (2.0 * options_.sigma_y * options_.sigma_y);
+  } else {
+    double mean = 0.0, var = 0.0;
+    for (const Candidate& h : hyp) mean += h.distance;
+    mean /= hyp.size();
+    for (const Candidate& h : hyp) var += (h.distance - mean) * (h.distance - mean);
+    var = std::max(var / hyp.size(), 1e-12);
+    for (size_t i = 0; i < hyp.size(); ++i) {
+      const double d = hyp[i].distance - nearest;
+      log_w[i] = -d * d / (2.0 * var);
+    }
+  }
+  const double top_log = *std::max_element(log_w.begin(), log_w.end());
+  std::vector<double> w(hyp.size());
+  double w_sum = 0.0;
+  for (size_t i = 0; i < hyp.size(); ++i) w_sum += (w[i] = std::exp(log_w[i] - top_log));
+  for (double& v : w) v /= w_sum;
+
+  std::vector<PoseX> poses(hyp.size());
+  for (size_t i = 0; i < hyp.size(); ++i) poses[i] = hyp[i].x;
+  w = CombineWithPrior(poses, w, carried_, options_, &result.prior_used);
+  for (size_t i = 0; i < hyp.size(); ++i) hyp[i].w = w[i];
+
+  std::vector<size_t> order(hyp.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return hyp[a].w > hyp[b].w; });
+  const Candidate& best = hyp[order[0]];
+
+  // Carry the best to the next frame.
+  carried_.clear();
+  double carried_sum = 0.0;
+  for (size_t r = 0; r < order.size() && static_cast<int>(r) < options_.carried; ++r) {
+    carried_.push_back({hyp[order[r]].x, hyp[order[r]].w});
+    carried_sum += hyp[order[r]].w;
+  }
+  for (WeightedPose& c : carried_) c.weight = carried_sum > 0.0 ? c.weight / carried_sum : 1.0 / carried_.size();
+
+  // Posteriors, confidence.
+  std::map<std::string, double> grasps, objects;
+  double squares = 0.0, mode = 0.0;
+  for (const Candidate& h : hyp) {
+    const EntryMeta meta = db_.Meta(h.entry);
+    const GraspDefinition& g = GraspTaxonomy()[meta.grasp - 1];
+    grasps[GraspKey(g)] += h.w;
+    objects[meta.with_object ? ToString(g.object.shape) : std::string("none")] += h.w;
+    squares += h.w * h.w;
+    if ((h.x - best.x).norm() < options_.sigma_x) mode += h.w;
+  }
+  result.grasps.assign(grasps.begin(), grasps.end());
+  result.objects.assign(objects.begin(), objects.end());
+  auto by_weight = [](const auto& a, const auto& b) { return a.second != b.second ? a.second > b.second : a.first < b.first; };
+  std::sort(result.grasps.begin(), result.grasps.end(), by_weight);
+  std::sort(result.objects.begin(), result.objects.end(), by_weight);
+  result.effective_samples = squares > 0.0 ? 1.0 / squares : 0.0;
+  result.confidence = std::min(1.0, mode);
+
+  for (size_t r = 0; r < order.size() && static_cast<int>(r) < options_.top_n; ++r) {
+    const Candidate& h = hyp[order[r]];
+    Hypothesis out;
+    out.entry = h.entry;
+    out.weight = h.w;
+    out.distance = h.distance;
+    out.turn = h.turn;
+    out.pose.angles = db_.Angles(h.entry);
+    out.pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), h.turn) *
+                                CameraFromHand(ViewpointFromDirection(directions_[db_.Meta(h.entry).viewpoint]));
+    result.top.push_back(out);
+  }
+  result.pose = result.top[0].pose;
+  result.ms.weigh = Ms(t, Clock::now());
+
+  // Placement: the best entry rendered as the database saw it tells where its keypoints lie
+  // in its crop; the query's crop maps them into the frame, and the two crops' scales give
+  // the distance.
+  t = Clock::now();
+  const Scene scene = EntryScene(best.entry);
+  cv::Mat labels;
+  renderer_.RenderLabels(scene, db_intrinsics_, &labels);
+  const std::optional<HandCrop> entry_crop = CropHand(labels == static_cast<int>(PixelLabel::kHand), config.Crop());
+  NPHAND_CHECK(entry_crop.has_value(), "entry ", best.entry, " has no hand to crop");
+  const HandCrop& query_crop = crops[best.turn_of];
+  const cv::Matx23d frame_from_crop = Invert(query_crop.crop_from_image);
+  const Keypoints3d entry_keypoints = db_.Keypoints(best.entry);
+  const double size = options_.hand_length_m / model_hand_length_;
+  const Intrinsics& camera = intrinsics_for(frame);
+  // A pixel of the database's render (pixel centres at +0.5) to the frame's.
+  auto to_frame = [&](const Eigen::Vector2d& pixel_in_entry) {
+    const Eigen::Vector2d in_crop = Apply(entry_crop->crop_from_image, pixel_in_entry.array() - 0.5);
+    const Eigen::Vector2d in_roi = Apply(frame_from_crop, in_crop);
+    return Eigen::Vector2d(in_roi.x() + roi.x + 0.5, in_roi.y() + roi.y + 0.5);
+  };
+  // The hand centre (on the database camera's axis) in the frame, and the ray to it: a hand
+  // off the axis is seen from a direction turned by that ray, so the entry's rotation is
+  // turned by it too.
+  const Eigen::Vector2d centre_px = to_frame(Project(db_intrinsics_, Eigen::Vector3d(0.0, 0.0, db_distance_)));
+  const Eigen::Vector3d ray =
+      Eigen::Vector3d((centre_px.x() - camera.cx) / camera.fx, (centre_px.y() - camera.cy) / camera.fy, 1.0).normalized();
+  const Eigen::Matrix3d towards_ray = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), ray).toRotationMatrix();
+  // The hand centre's distance: the database's, scaled by the focal lengths, the crops'
+  // scales and the hand's size.
+  const double range = db_distance_ * (camera.fx / db_intrinsics_.fx) * size *
+                       (Scale(query_crop.crop_from_image) / Scale(entry_crop->crop_from_image));
+  const Eigen::Matrix3d rotation = towards_ray * AxisAngle(Eigen::Vector3d::UnitZ(), best.turn);
+  result.pose.camera_from_hand = towards_ray * result.pose.camera_from_hand;
+  for (Hypothesis& h : result.top) h.pose.camera_from_hand = towards_ray * h.pose.camera_from_hand;
+  const Eigen::Vector3d wrist = range * ray - size * (result.pose.camera_from_hand * hand_.bind_centre());
+  result.depth_m = range * ray.z();
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    result.keypoints_2d[k] = to_frame(Project(db_intrinsics_, scene.wrist_in_camera + entry_keypoints[k]));
+    result.keypoints_hand[k] = size * (rotation * entry_keypoints[k]);
+    result.keypoints_camera[k] = wrist + result.keypoints_hand[k];
+  }
+  result.box = box;
+  result.status = FrameStatus::kDetected;
+  result.ms.place = Ms(t, Clock::now());
+  return result;
+}
+
+}  // namespace nphand

@@ -1,0 +1,180 @@
+// The estimator (PAPER.md Sec. 3 and 5): from a camera frame to the hand's full 3D pose.
+// A frame is skin-segmented, the hand chosen among the skin regions and cut at the wrist,
+// described by the database's descriptor (roll-normalised HOG), and its K nearest database
+// entries found; each neighbour becomes a hypothesis (its pose turned by the two rolls),
+// weighted by its feature distance (the observation) and by a kernel density over the
+// previous frame's weighted hypotheses (the temporal prior). The best hypothesis is the
+// estimate; the weighted set carries to the next frame. The result also places the hand:
+// 21 keypoints in the image, in 3D about the wrist and in the camera frame.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "nphand/db/database.h"
+#include "nphand/index/knn_index.h"
+#include "nphand/model/hand_model.h"
+#include "nphand/render/camera.h"
+#include "nphand/render/renderer.h"
+#include "nphand/scene/grasp.h"
+#include "nphand/segment/forearm.h"
+#include "nphand/segment/skin.h"
+
+namespace nphand {
+
+// How a neighbour's feature distance d becomes its weight.
+enum class ObservationWeight : uint8_t {
+  kFixed,     // the paper: exp(-d^2 / (2 sigma_y^2))
+  kAdaptive,  // the released code: exp(-(d - d_min)^2 / (2 var(d))) over the K distances
+};
+// How the observation weight w and the prior density g combine.
+enum class PriorCombination : uint8_t {
+  kNone,     // the observation alone (the paper's "NN feature" with weights)
+  kProduct,  // the paper: w* = w g
+  kSum,      // the released code: w* = (1 - prior_share) w + prior_share g, each normalised
+};
+std::string ToString(ObservationWeight weight);
+std::string ToString(PriorCombination combination);
+ObservationWeight ObservationWeightFromString(const std::string& text);
+PriorCombination PriorCombinationFromString(const std::string& text);
+
+struct EstimatorOptions {
+  int k = 500;                                  // neighbours searched (the paper's K)
+  ObservationWeight observation = ObservationWeight::kAdaptive;
+  double sigma_y = 0.05;                        // kFixed: feature-distance scale (L2 of the descriptor)
+  PriorCombination prior = PriorCombination::kProduct;
+  double sigma_x = 0.5;                         // the prior's kernel width in pose-vector units
+  double prior_share = 0.9;                     // kSum's weight on the prior
+  int carried = 20;                             // hypotheses carried to the next frame
+  int top_n = 5;                                // hypotheses in each result
+  // Search the half-turned crop too when the silhouette's skewness is below this (its two
+  // ends look alike, so the principal axis's direction is a guess).
+  double roll_ambiguity = 0.15;
+  // No hand unless the nearest database entry is at most this far in feature space.
+  double max_distance = 0.6;
+  Handedness hand = Handedness::kRight;         // left: mirrored into the right-hand database
+  // Camera: a focal length in pixels, or (focal_px = 0) a horizontal field of view.
+  double focal_px = 0.0;
+  double fov_deg = 60.0;
+  double hand_length_m = 0.18;                  // wrist to middle fingertip, an adult's
+  SkinOptions skin;
+  bool cut_forearm = true;
+  ForearmCutOptions forearm;
+  int learn_interval = 10;                      // frames between skin-colour updates from confident frames
+  bool Check(std::string* why) const;
+};
+
+enum class FrameStatus : uint8_t {
+  kDetected,
+  kNoSkin,     // no skin-coloured region of a hand's size
+  kNotAHand,   // skin, but no region looks like any database view (e.g. only a face)
+};
+std::string ToString(FrameStatus status);
+
+struct Hypothesis {
+  uint32_t entry = 0;             // database entry
+  double weight = 0.0;            // normalised over the frame's hypotheses
+  double distance = 0.0;          // L2 feature distance
+  double turn = 0.0;              // radians: the query's roll minus the entry's (the image-plane turn)
+  HandPose pose;                  // the entry's pose turned by `turn` (mirrored for a left hand)
+};
+
+struct StageMilliseconds {
+  double segment = 0.0, describe = 0.0, search = 0.0, weigh = 0.0, place = 0.0, total = 0.0;
+};
+
+struct FrameResult {
+  int frame = 0;
+  double time_s = 0.0;
+  FrameStatus status = FrameStatus::kNoSkin;
+  std::string reason;                          // why not detected, for people
+  bool detected() const { return status == FrameStatus::kDetected; }
+  // The estimate (valid when detected).
+  HandPose pose;
+  Keypoints3d keypoints_hand{};                // metres, camera orientation, wrist at the origin, the user's hand size
+  Keypoints3d keypoints_camera{};              // metres, camera frame
+  std::array<Eigen::Vector2d, kNumKeypoints> keypoints_2d{};  // pixels (pixel centres at +0.5)
+  double depth_m = 0.0;                        // the hand centre's distance along the optical axis
+  cv::Rect box;                                // the hand's pixels (after the forearm cut)
+  bool forearm_cut = false;
+  bool both_turns = false;                     // the half-turned crop was searched too
+  bool prior_used = false;                     // the temporal prior took part
+  std::vector<Hypothesis> top;                 // the best top_n, best first
+  std::vector<std::pair<std::string, double>> grasps;   // posterior over grasp names, descending
+  std::vector<std::pair<std::string, double>> objects;  // posterior over object shapes ("none": no object)
+  double nearest_distance = 0.0;               // the best neighbour's feature distance
+  double effective_samples = 0.0;              // 1 / sum w^2 over the hypotheses
+  double confidence = 0.0;                     // the posterior mass near the estimate, 0..1
+  StageMilliseconds ms;
+};
+
+using PoseX = Eigen::Matrix<double, kPoseVectorSize, 1>;  // the paper's pose vector x
+
+struct WeightedPose {
+  PoseX x;
+  double weight;
+};
+
+// The temporal step: hypotheses' observation weights (normalised) combined with the kernel
+// density over the previous frame's weighted hypotheses `carried`, as `options` says
+// (prior, sigma_x, prior_share); normalised. Without a prior, or when the prior gives every
+// hypothesis nothing (the hand jumped), the observation weights come back and
+// `*prior_used` is false.
+std::vector<double> CombineWithPrior(const std::vector<PoseX>& poses, const std::vector<double>& observation,
+                                     const std::vector<WeightedPose>& carried, const EstimatorOptions& options,
+                                     bool* prior_used);
+
+class Estimator {
+ public:
+  // `db`, `index` (built for `db`) and `hand` (the model `db` was rendered from) must outlive
+  // the estimator. Throws nphand::Error for invalid options, an index of another database,
+  // a hand model of another asset, or a database of the other hand.
+  Estimator(const Database& db, const KnnIndex& index, const HandModel& hand, const EstimatorOptions& options);
+
+  // The next frame (8-bit BGR) of a video at `time_s`.
+  FrameResult Process(const cv::Mat& bgr, double time_s);
+  // The same from a hand mask (CV_8UC1, non-zero = hand) instead of a frame: no
+  // segmentation, no region choice, no forearm cut.
+  FrameResult ProcessMask(const cv::Mat& mask, double time_s);
+  // Forgets the temporal state and the learned skin colours (a new video).
+  void Reset();
+
+  const EstimatorOptions& options() const { return options_; }
+  const Intrinsics& intrinsics_for(cv::Size frame) const;
+  // The database entry rendered as the database saw it (labels, RGB): for overlays.
+  RenderedImages RenderEntry(uint32_t entry);
+
+ private:
+  // Everything after the hand's mask: describe, search, weigh, place. `hand_mask` is
+  // frame-sized, `box` its pixels' bounds; `result` comes with frame, time and segmentation
+  // time filled in.
+  FrameResult Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result);
+  const Grasp& GraspOf(int id);
+  Scene EntryScene(uint32_t entry);
+
+  const Database& db_;
+  const KnnIndex& index_;
+  const HandModel& hand_;
+  EstimatorOptions options_;
+  SkinSegmenter segmenter_;
+  Renderer renderer_;
+  Intrinsics db_intrinsics_;
+  double db_distance_ = 0.5;
+  std::vector<Eigen::Vector3d> directions_;
+  std::vector<std::optional<Grasp>> grasps_;  // by taxonomy number, made when first needed
+  double model_hand_length_ = 0.0;
+  mutable Intrinsics frame_intrinsics_;
+  std::vector<WeightedPose> carried_;
+  std::optional<cv::Point2d> last_centre_;
+  int frame_ = 0;
+  int since_learn_ = 0;
+};
+
+}  // namespace nphand

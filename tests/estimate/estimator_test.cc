@@ -1,0 +1,264 @@
+#include "nphand/estimate/estimator.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <numbers>
+#include <tuple>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "nphand/db/builder.h"
+#include "nphand/index/backends.h"
+#include "nphand/scene/viewpoint.h"
+#include "nphand/sequence/sequence.h"
+#include "testing/testing.h"
+
+namespace nphand {
+namespace {
+
+using testing::RightHand;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A small database: two grasps, 5 steps, with and without the object, 64 directions.
+class EstimatorTest : public ::testing::Test {
+ protected:
+  static std::filesystem::path Path() {
+    return std::filesystem::temp_directory_path() / ("nphand_estimator_" + std::to_string(::getpid()) + ".db");
+  }
+  static void SetUpTestSuite() {
+    DatabaseBuildOptions options;
+    options.grasps = {1, 13};
+    options.directions = 64;
+    options.threads = 2;
+    BuildDatabase(RightHand(), options, Path(), nullptr);
+    db_ = new Database(Database::Open(Path()));
+    index_ = BuildIndex(*db_, IndexOptions::Exact()).release();
+  }
+  static void TearDownTestSuite() {
+    delete index_;
+    delete db_;
+    std::filesystem::remove(Path());
+  }
+  static EstimatorOptions Options() {
+    EstimatorOptions options;
+    options.k = 50;
+    // 64 directions leave far wider gaps than the default database's 648.
+    options.max_distance = 0.8;
+    options.skin.face_cascade.clear();
+    return options;
+  }
+  // The scene of entry `e` seen by `camera` at `distance`, turned in the image by `roll`.
+  static Scene EntryScene(size_t e, double roll, double distance) {
+    const EntryMeta meta = db_->Meta(e);
+    Scene scene;
+    scene.hand.angles = db_->Angles(e);
+    const std::vector<Eigen::Vector3d> directions = ViewSphereDirections(64);
+    scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(directions[meta.viewpoint], roll));
+    scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, RightHand().bind_centre(), distance);
+    return scene;
+  }
+  static inline Database* db_ = nullptr;
+  static inline KnnIndex* index_ = nullptr;
+};
+
+// An entry without its object: its pose, its scene.
+size_t EntryWithoutObject(const Database& db, size_t from) {
+  for (size_t e = from; e < db.size(); ++e) {
+    if (!db.Meta(e).with_object && db.Meta(e).has_hand) return e;
+  }
+  return 0;
+}
+
+TEST_F(EstimatorTest, AFrameAtADatabaseEntryIsThatEntryAndARolledOneComesBackWithItsRoll) {
+  Estimator estimator(*db_, *index_, RightHand(), Options());
+  for (size_t from : {70u, 400u, 555u}) {
+    const size_t e = EntryWithoutObject(*db_, from);
+    const RenderedImages images = estimator.RenderEntry(static_cast<uint32_t>(e));
+    estimator.Reset();
+    const FrameResult exact = estimator.ProcessMask(images.labels == static_cast<int>(PixelLabel::kHand), 0.0);
+    ASSERT_TRUE(exact.detected()) << exact.reason;
+    EXPECT_EQ(exact.top[0].entry, e);
+    EXPECT_NEAR(exact.nearest_distance, 0.0, 1e-3);
+    EXPECT_LT(RotationAngleDeg(exact.pose.camera_from_hand, EntryScene(e, 0.0, 0.5).hand.camera_from_hand), 0.5);
+    for (double roll_deg : {35.0, -120.0}) {
+      const Scene scene = EntryScene(e, roll_deg * kDeg, 0.5);
+      cv::Mat labels;
+      Renderer renderer(RightHand());
+      renderer.RenderLabels(scene, Intrinsics::FromFieldOfView(128, 128, 30 * kDeg), &labels);
+      estimator.Reset();
+      const FrameResult rolled = estimator.ProcessMask(labels == static_cast<int>(PixelLabel::kHand), 0.0);
+      ASSERT_TRUE(rolled.detected());
+      EXPECT_EQ(rolled.top[0].entry, e) << roll_deg;
+      EXPECT_LT(RotationAngleDeg(rolled.pose.camera_from_hand, scene.hand.camera_from_hand), 4.0) << roll_deg;
+    }
+  }
+}
+
+TEST_F(EstimatorTest, KeypointsAndDistanceArePlacedInTheFrame) {
+  EstimatorOptions options = Options();
+  options.fov_deg = 60.0;
+  const size_t e = EntryWithoutObject(*db_, 300);
+  // The model's own hand length, so that only the camera and the crop decide the distance.
+  const Keypoints3d k = db_->Keypoints(e);
+  options.hand_length_m = (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
+  Estimator estimator(*db_, *index_, RightHand(), options);
+  const Intrinsics camera = Intrinsics::FromFieldOfView(640, 480, 60 * kDeg);
+  // Centred, and off the axis (seen from a turned direction, which the sparse database
+  // matches less well).
+  for (const auto& [distance, offset, tolerance] :
+       {std::tuple{0.35, Eigen::Vector3d(0, 0, 0), 0.03}, std::tuple{0.6, Eigen::Vector3d(0.05, -0.03, 0.0), 0.06}}) {
+    Scene scene = EntryScene(e, 20 * kDeg, distance);
+    scene.wrist_in_camera += offset;
+    cv::Mat labels;
+    Renderer renderer(RightHand());
+    renderer.RenderLabels(scene, camera, &labels);
+    estimator.Reset();
+    const FrameResult r = estimator.ProcessMask(labels == static_cast<int>(PixelLabel::kHand), 0.0);
+    ASSERT_TRUE(r.detected());
+    const Keypoints3d truth = RightHand().KeypointsOf(scene.hand);
+    double error_px = 0.0, error_m = 0.0;
+    for (int j = 0; j < kNumKeypoints; ++j) {
+      error_px += (r.keypoints_2d[j] - Project(camera, scene.wrist_in_camera + truth[j])).norm() / kNumKeypoints;
+      error_m += (r.keypoints_camera[j] - (scene.wrist_in_camera + truth[j])).norm() / kNumKeypoints;
+    }
+    const double hand_px = (Project(camera, scene.wrist_in_camera + truth[12]) - Project(camera, scene.wrist_in_camera)).norm();
+    EXPECT_LT(error_px, tolerance * hand_px) << distance;
+    EXPECT_NEAR(r.depth_m, scene.wrist_in_camera.z() + (scene.hand.camera_from_hand * RightHand().bind_centre()).z(),
+                tolerance * distance);
+    EXPECT_LT(error_m, tolerance * distance) << distance;
+  }
+}
+
+TEST_F(EstimatorTest, ALeftHandIsTheMirroredRightHand) {
+  const size_t e = EntryWithoutObject(*db_, 200);
+  EstimatorOptions options = Options();
+  Estimator right(*db_, *index_, RightHand(), options);
+  options.hand = Handedness::kLeft;
+  Estimator left(*db_, *index_, RightHand(), options);
+  const Scene scene = EntryScene(e, 50 * kDeg, 0.5);
+  cv::Mat labels, mirrored;
+  Renderer renderer(RightHand());
+  renderer.RenderLabels(scene, Intrinsics::FromFieldOfView(160, 120, 40 * kDeg), &labels);
+  cv::flip(labels, mirrored, 1);
+  const FrameResult r = right.ProcessMask(labels == 1, 0.0);
+  const FrameResult l = left.ProcessMask(mirrored == 1, 0.0);
+  ASSERT_TRUE(r.detected());
+  ASSERT_TRUE(l.detected());
+  EXPECT_EQ(l.pose.handedness, Handedness::kLeft);
+  EXPECT_EQ(l.top[0].entry, r.top[0].entry);
+  EXPECT_LT(RotationAngleDeg(l.pose.camera_from_hand, MirrorPose(r.pose).camera_from_hand), 0.5);
+  EXPECT_EQ(l.pose.angles, r.pose.angles);
+  for (int j = 0; j < kNumKeypoints; ++j) {
+    EXPECT_NEAR(l.keypoints_2d[j].x(), 160 - r.keypoints_2d[j].x(), 0.6);
+    EXPECT_NEAR(l.keypoints_camera[j].x(), -r.keypoints_camera[j].x(), 1e-3);
+  }
+}
+
+TEST(CombineWithPriorTest, WeightsAreNormalisedAndTwoModesSurviveUntilTheObservationSeparatesThem) {
+  PoseX a = PoseX::Zero(), b = PoseX::Zero();
+  b[9] = 2.0;  // far apart in pose space
+  EstimatorOptions options;
+  options.prior = PriorCombination::kProduct;
+  options.sigma_x = 0.3;
+  // The previous frame left two equal modes.
+  const std::vector<WeightedPose> carried = {{a, 0.5}, {b, 0.5}};
+  // Hypotheses near each mode, and one far from both.
+  PoseX near_a = a, near_b = b, elsewhere = PoseX::Zero();
+  near_a[10] = 0.05;
+  near_b[10] = -0.05;
+  elsewhere[11] = 3.0;
+  const std::vector<PoseX> poses = {near_a, near_b, elsewhere};
+  bool used = false;
+  // An observation that cannot tell them apart keeps both modes, and drops the stranger.
+  std::vector<double> w = CombineWithPrior(poses, {0.3, 0.3, 0.4}, carried, options, &used);
+  EXPECT_TRUE(used);
+  EXPECT_NEAR(w[0] + w[1] + w[2], 1.0, 1e-12);
+  EXPECT_NEAR(w[0], w[1], 1e-9);
+  EXPECT_LT(w[2], 1e-6);
+  // The next frame carries both; an observation that favours one settles it.
+  const std::vector<WeightedPose> both = {{near_a, w[0]}, {near_b, w[1]}};
+  w = CombineWithPrior(poses, {0.8, 0.1, 0.1}, both, options, &used);
+  EXPECT_GT(w[0], 0.85);
+  // The weighted sum keeps some of the observation; no prior gives the observation back.
+  options.prior = PriorCombination::kSum;
+  w = CombineWithPrior(poses, {0.3, 0.3, 0.4}, carried, options, &used);
+  EXPECT_NEAR(w[0] + w[1] + w[2], 1.0, 1e-12);
+  EXPECT_NEAR(w[2], 0.1 * 0.4, 1e-6);
+  w = CombineWithPrior(poses, {0.3, 0.3, 0.4}, {}, options, &used);
+  EXPECT_FALSE(used);
+  EXPECT_EQ(w, (std::vector<double>{0.3, 0.3, 0.4}));
+  // A prior that gives nothing to any hypothesis (the hand jumped) is dropped.
+  PoseX far = PoseX::Constant(50.0);
+  w = CombineWithPrior(poses, {0.3, 0.3, 0.4}, {{far, 1.0}}, options, &used);
+  EXPECT_FALSE(used);
+}
+
+TEST_F(EstimatorTest, FramesWithoutAHandSaySo) {
+  Estimator estimator(*db_, *index_, RightHand(), Options());
+  const cv::Mat wall = MakeBackground(BackgroundKind::kTexture, cv::Size(320, 240), 3);
+  FrameResult r = estimator.Process(wall, 0.0);
+  EXPECT_EQ(r.status, FrameStatus::kNoSkin);
+  EXPECT_FALSE(r.reason.empty());
+  cv::Mat face = wall.clone();
+  DrawFace(SkinToneByName("olive").bgr, cv::Point(160, 110), 160, &face);
+  r = estimator.Process(face, 0.04);
+  EXPECT_FALSE(r.detected()) << "nearest distance " << r.nearest_distance;
+  EXPECT_EQ(estimator.ProcessMask(cv::Mat::zeros(10, 10, CV_8UC1), 0.0).status, FrameStatus::kNoSkin);
+}
+
+TEST_F(EstimatorTest, RenderedSequenceFramesAreEstimatedWithEveryField) {
+  Estimator estimator(*db_, *index_, RightHand(), Options());
+  SequenceOptions options;
+  options.frames = 6;
+  options.grasp = 1;
+  options.width = 320;
+  options.height = 240;
+  options.distance_m = 0.35;
+  options.seed = testing::kTestSeed;
+  Sequence sequence(RightHand(), options);
+  int detected = 0;
+  for (int i = 0; i < sequence.size(); ++i) {
+    const SequenceFrame frame = sequence.Render(i);
+    const FrameResult r = estimator.Process(frame.rgb, frame.time_s);
+    if (!r.detected()) continue;
+    ++detected;
+    EXPECT_EQ(static_cast<int>(r.top.size()), estimator.options().top_n);
+    double grasp_sum = 0.0, object_sum = 0.0;
+    for (const auto& [name, p] : r.grasps) grasp_sum += p;
+    for (const auto& [name, p] : r.objects) object_sum += p;
+    EXPECT_NEAR(grasp_sum, 1.0, 1e-9);
+    EXPECT_NEAR(object_sum, 1.0, 1e-9);
+    EXPECT_GE(r.effective_samples, 1.0);
+    EXPECT_TRUE(r.pose.IsValid());
+    EXPECT_EQ(r.prior_used, detected > 1);
+    // The 2D keypoints land near the hand.
+    const cv::Rect near(r.box.x - r.box.width / 2, r.box.y - r.box.height / 2, 2 * r.box.width, 2 * r.box.height);
+    for (const Eigen::Vector2d& k : r.keypoints_2d) EXPECT_TRUE(near.contains(cv::Point(k.x(), k.y())));
+  }
+  EXPECT_GE(detected, 5);
+}
+
+TEST_F(EstimatorTest, BadSetUpsAreRefused) {
+  EstimatorOptions options = Options();
+  options.k = 0;
+  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "k must be");
+  testing::ExpectError([&] { Estimator(*db_, *index_, testing::LeftHand(), Options()); }, "right hand model");
+  // An index of another descriptor.
+  IndexedSet other = DatabaseDescriptors(*db_);
+  DescriptorConfig config = other.descriptors.config();
+  config.hog.bins = 4;
+  config.hog.cells = 16;
+  IndexedSet forged{DescriptorMatrix(config, other.descriptors.values()), other.ids};
+  const std::unique_ptr<KnnIndex> wrong = BuildIndex(std::move(forged), IndexOptions::Exact());
+  testing::ExpectError([&] { Estimator(*db_, *wrong, RightHand(), Options()); }, "index");
+  Estimator estimator(*db_, *index_, RightHand(), Options());
+  testing::ExpectError([&] { estimator.Process(cv::Mat(), 0.0); }, "8-bit BGR");
+  testing::ExpectError([] { PriorCombinationFromString("max"); }, "none, product or sum");
+  testing::ExpectError([] { ObservationWeightFromString("x"); }, "fixed or adaptive");
+}
+
+}  // namespace
+}  // namespace nphand
