@@ -1,6 +1,8 @@
 // nphand: one binary, one subcommand per pipeline job. Each subcommand binds its flags to
 // the fields of an options struct and calls the matching Run* function.
 #include <algorithm>
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 
@@ -8,6 +10,7 @@
 
 #include "apps/bench_command.h"
 #include "apps/db_command.h"
+#include "apps/estimate_command.h"
 #include "apps/eval_command.h"
 #include "apps/index_command.h"
 #include "apps/render_command.h"
@@ -91,6 +94,45 @@ void AddSequenceCommand(CLI::App& app, nphand::SequenceCommandOptions& o) {
     std::cout << (o.out_dir / "frames").string() << "\n" << (o.out_dir / "truth.jsonl").string() << "\n"
               << "grasp " << description["grasp"]["name"].get<std::string>() << ", skin "
               << description["skin"].get<std::string>() << ", " << description["frames"] << " frames\n";
+  });
+}
+
+std::atomic<bool> g_stop{false};
+
+void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
+  CLI::App* cmd = app.add_subcommand("estimate", "Estimate the hand's 3D pose in every frame of a video, image folder or camera");
+  nphand::EstimatorOptions& e = o.estimator;
+  cmd->add_option("--db", o.db, "Database file")->capture_default_str();
+  cmd->add_option("--index", o.index, "Index file (default: the database's path + .idx)");
+  cmd->add_option("--input", o.input, "Video file, image folder (name order) or camera index")->required();
+  cmd->add_option("--out", o.out, "JSON lines, one object per frame (docs/FORMAT.md)")->capture_default_str();
+  cmd->add_option("--overlay", o.overlay, "Overlay video (.mp4): the skeleton, and the matched database view beside it");
+  cmd->add_option("--hand", o.hand, "right or left (a left hand is mirrored into the right-hand database)")->capture_default_str();
+  cmd->add_option("--k", e.k, "Neighbours searched per frame")->capture_default_str();
+  cmd->add_option("--observation", o.observation, "Observation weight: fixed (the paper) or adaptive (the released code)")
+      ->capture_default_str();
+  cmd->add_option("--sigma-y", e.sigma_y, "Fixed observation weight's feature-distance scale")->capture_default_str();
+  cmd->add_option("--prior", o.prior, "Temporal prior: none, product (the paper) or sum (the released code)")->capture_default_str();
+  cmd->add_option("--sigma-x", e.sigma_x, "Prior kernel width, pose-vector units")->capture_default_str();
+  cmd->add_option("--prior-share", e.prior_share, "The weighted sum's share of the prior")->capture_default_str();
+  cmd->add_option("--carried", e.carried, "Hypotheses carried to the next frame")->capture_default_str();
+  cmd->add_option("--top-n", e.top_n, "Hypotheses kept per frame")->capture_default_str();
+  cmd->add_flag("--top", o.top, "Write the top-N hypotheses in each line");
+  cmd->add_option("--max-distance", e.max_distance, "No hand when the nearest view is farther than this")->capture_default_str();
+  cmd->add_option("--focal", e.focal_px, "Focal length in pixels (0: from --fov)")->capture_default_str();
+  cmd->add_option("--fov", e.fov_deg, "Horizontal field of view, degrees")->capture_default_str();
+  cmd->add_option("--hand-length", e.hand_length_m, "Wrist to middle fingertip, metres")->capture_default_str();
+  cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
+  cmd->add_flag("!--no-forearm-cut", e.cut_forearm, "Do not cut the forearm at the wrist");
+  cmd->add_option("--fps", o.fps, "Frame rate of an image folder")->capture_default_str();
+  cmd->add_option("--max-frames", o.max_frames, "Stop after this many frames (0: all)")->capture_default_str();
+  cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+  cmd->callback([&o]() {
+    // Ctrl-C ends the run after the current frame, with complete files.
+    std::signal(SIGINT, [](int) { g_stop = true; });
+    const nlohmann::json summary = nphand::RunEstimate(o, &std::cerr, &g_stop);
+    std::signal(SIGINT, SIG_DFL);
+    std::cout << summary.dump(2) << "\n";
   });
 }
 
@@ -300,6 +342,8 @@ int main(int argc, char** argv) {
   AddRenderCommand(app, render_options);
   nphand::SequenceCommandOptions sequence_options;
   AddSequenceCommand(app, sequence_options);
+  nphand::EstimateCommandOptions estimate_options;
+  AddEstimateCommand(app, estimate_options);
   AddBenchCommand(app, bench_options, json);
   DbArgs db_args;
   AddDbCommand(app, db_args);

@@ -9,11 +9,16 @@
 namespace nphand {
 
 void DrawKeypoints(const Intrinsics& intrinsics, const Keypoints3d& keypoints, cv::Mat* bgr) {
+  std::array<Eigen::Vector2d, kNumKeypoints> pixels;
+  for (int k = 0; k < kNumKeypoints; ++k) pixels[k] = Project(intrinsics, keypoints[k]);
+  DrawKeypoints2d(pixels, bgr);
+}
+
+void DrawKeypoints2d(const std::array<Eigen::Vector2d, kNumKeypoints>& keypoints, cv::Mat* bgr) {
   NPHAND_THROW_CHECK(bgr->type() == CV_8UC3, "keypoints can only be drawn on a BGR image");
   const int radius = std::max(2, bgr->cols / 160);
   auto pixel = [&](int k) {
-    const Eigen::Vector2d p = Project(intrinsics, keypoints[k]);
-    return cv::Point(static_cast<int>(std::lround(p.x() - 0.5)), static_cast<int>(std::lround(p.y() - 0.5)));
+    return cv::Point(static_cast<int>(std::lround(keypoints[k].x() - 0.5)), static_cast<int>(std::lround(keypoints[k].y() - 0.5)));
   };
   // One colour per finger (BGR): thumb, index, middle, ring, little.
   const cv::Scalar colours[5] = {{0, 0, 255}, {0, 200, 255}, {0, 220, 0}, {255, 160, 0}, {255, 0, 200}};

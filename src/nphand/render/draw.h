@@ -1,6 +1,7 @@
 // Drawing overlays for people to look at: the 21 keypoints and their skeleton.
 #pragma once
 
+#include <array>
 #include <filesystem>
 
 #include <opencv2/core.hpp>
@@ -12,6 +13,8 @@ namespace nphand {
 
 // Draws the keypoints (camera frame, metres) and the bones between them on a BGR image.
 void DrawKeypoints(const Intrinsics& intrinsics, const Keypoints3d& keypoints_in_camera, cv::Mat* bgr);
+// The same from keypoints already in pixels (pixel centres at +0.5).
+void DrawKeypoints2d(const std::array<Eigen::Vector2d, kNumKeypoints>& keypoints, cv::Mat* bgr);
 
 // A label image (PixelLabel values) as a grey picture: background black, hand white, object grey.
 cv::Mat LabelsForDisplay(const cv::Mat& labels);

@@ -1,0 +1,78 @@
+#include "apps/frame_source.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "nphand/util/check.h"
+
+namespace nphand {
+namespace {
+
+bool IsImage(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" || ext == ".tiff";
+}
+
+}  // namespace
+
+FrameSource::FrameSource(const std::string& input, double fps) : input_(input), fps_(fps) {
+  NPHAND_THROW_CHECK(!input.empty(), "--input: give a video file, an image folder or a camera index");
+  NPHAND_THROW_CHECK(fps > 0.0 && fps <= 1000.0, "--fps must be within (0, 1000]");
+  const std::filesystem::path path(input);
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    kind_ = "folder";
+    for (const auto& item : std::filesystem::directory_iterator(path)) {
+      if (item.is_regular_file() && IsImage(item.path())) images_.push_back(item.path());
+    }
+    std::sort(images_.begin(), images_.end());
+    NPHAND_THROW_CHECK(!images_.empty(), input, ": no images in this folder (.png, .jpg, .bmp, .tif)");
+    count_ = images_.size();
+    return;
+  }
+  const bool digits = std::all_of(input.begin(), input.end(), [](unsigned char c) { return std::isdigit(c); });
+  if (digits && !std::filesystem::exists(path, error)) {
+    kind_ = "camera";
+    NPHAND_THROW_CHECK(input.size() < 4, "--input ", input, ": not a camera index (0..999)");
+    capture_.open(std::stoi(input), cv::CAP_ANY);
+    NPHAND_THROW_CHECK(capture_.isOpened(), "camera ", input, " is not there (or cannot be opened)");
+    const double camera_fps = capture_.get(cv::CAP_PROP_FPS);
+    if (camera_fps > 0.0) fps_ = camera_fps;
+    return;
+  }
+  NPHAND_THROW_CHECK(std::filesystem::exists(path, error), input, ": no such file or folder");
+  NPHAND_THROW_CHECK(std::filesystem::is_regular_file(path, error), input, ": not a video file or an image folder");
+  kind_ = "video";
+  capture_.open(input, cv::CAP_ANY);
+  NPHAND_THROW_CHECK(capture_.isOpened(), input, ": cannot read this as a video");
+  const double video_fps = capture_.get(cv::CAP_PROP_FPS);
+  if (video_fps > 0.0) fps_ = video_fps;
+  const double frames = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+  count_ = frames > 0.0 ? static_cast<uint64_t>(frames) : 0;
+}
+
+std::optional<Frame> FrameSource::Next() {
+  Frame frame;
+  frame.time_s = static_cast<double>(next_) / fps_;
+  if (kind_ == "folder") {
+    if (next_ >= images_.size()) return std::nullopt;
+    const std::filesystem::path& path = images_[next_];
+    frame.bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
+    NPHAND_THROW_CHECK(!frame.bgr.empty(), path.string(), ": cannot read this image");
+    frame.name = path.filename().string();
+  } else {
+    if (!capture_.read(frame.bgr) || frame.bgr.empty()) {
+      // A video that gives not even its first frame is not a video.
+      NPHAND_THROW_CHECK(next_ > 0, input_, ": no frame could be read from this ", kind_);
+      return std::nullopt;
+    }
+  }
+  NPHAND_THROW_CHECK(frame.bgr.type() == CV_8UC3, input_, ": frame ", next_, " is not an 8-bit colour image");
+  ++next_;
+  return frame;
+}
+
+}  // namespace nphand
