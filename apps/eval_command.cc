@@ -40,4 +40,30 @@ AnnStudyResult RunEvalAnn(const EvalAnnCommandOptions& options) {
   return result;
 }
 
+std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& options) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.study.Check(&why), "eval estimator: ", why);
+  if (!options.out_dir.empty()) {
+    CheckFileName(options.name, "eval estimator --name");
+    CheckOutputFolder(options.out_dir, "eval estimator --out");
+  }
+  const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+  const Database db = Database::Open(options.db);
+  const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
+  const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
+  const std::vector<EstimatorScore> scores = RunEstimatorStudy(db, *index, hand, EstimatorOptions{}, options.study, &std::cerr);
+  if (!options.out_dir.empty()) {
+    nlohmann::json json = {{"study", "estimator validation sweep"},
+                           {"database", options.db.filename().string()},
+                           {"index", index->Backend()},
+                           {"sequences", options.study.sequences},
+                           {"frames", options.study.frames},
+                           {"size", {options.study.width, options.study.height}},
+                           {"seed", options.study.seed},
+                           {"rows", ToJson(scores)}};
+    WriteFileAtomic(options.out_dir / (options.name + ".json"), json.dump(2) + "\n");
+  }
+  return scores;
+}
+
 }  // namespace nphand

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "nphand/eval/ann_study.h"
+#include "nphand/eval/estimator_study.h"
 #include "nphand/eval/feature_study.h"
 
 namespace nphand {
@@ -28,5 +29,17 @@ struct EvalAnnCommandOptions {
 };
 
 AnnStudyResult RunEvalAnn(const EvalAnnCommandOptions& options);
+
+struct EvalEstimatorCommandOptions {
+  std::filesystem::path db = "out/nphand.db";
+  std::filesystem::path index;  // default: the database's path + ".idx"
+  std::filesystem::path asset_dir = DefaultAssetDir();
+  std::filesystem::path out_dir;  // if set: <name>.json there
+  std::string name = "estimator_study";
+  EstimatorStudyOptions study;
+};
+
+// The estimator's validation sweep (docs/estimator.md).
+std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& options);
 
 }  // namespace nphand

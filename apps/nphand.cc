@@ -283,10 +283,38 @@ void AddEvalAnnCommand(CLI::App* eval, nphand::EvalAnnCommandOptions& o, bool& j
   });
 }
 
-void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, nphand::EvalAnnCommandOptions& ann, bool& json) {
+void AddEvalEstimatorCommand(CLI::App* eval, nphand::EvalEstimatorCommandOptions& o, bool& json) {
+  CLI::App* cmd = eval->add_subcommand(
+      "estimator", "The estimator's validation sweep: observation weight, prior, carried hypotheses and K on rendered sequences");
+  nphand::EstimatorStudyOptions& s = o.study;
+  cmd->add_option("--db", o.db, "Database file")->capture_default_str();
+  cmd->add_option("--index", o.index, "Index file (default: the database's path + .idx)");
+  cmd->add_option("--sequences", s.sequences, "Validation sequences")->capture_default_str();
+  cmd->add_option("--frames", s.frames, "Frames per sequence")->capture_default_str();
+  cmd->add_option("--width", s.width, "Frame width")->capture_default_str();
+  cmd->add_option("--height", s.height, "Frame height")->capture_default_str();
+  cmd->add_option("--seed", s.seed, "Sequence i uses seed + i")->capture_default_str();
+  cmd->add_option("--settings", s.settings, "Settings to run (default: the whole sweep)")->delimiter(',');
+  cmd->add_option("--out", o.out_dir, "Folder for the JSON");
+  cmd->add_option("--name", o.name, "File name of the JSON")->capture_default_str();
+  cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+  cmd->add_flag("--json", json, "Print JSON instead of the table");
+  cmd->callback([&o, &json]() {
+    const std::vector<nphand::EstimatorScore> scores = nphand::RunEvalEstimator(o);
+    if (json) {
+      std::cout << nphand::ToJson(scores).dump() << "\n";
+    } else {
+      std::cout << nphand::FormatTable(scores);
+    }
+  });
+}
+
+void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, nphand::EvalAnnCommandOptions& ann,
+                    nphand::EvalEstimatorCommandOptions& estimator, bool& json) {
   CLI::App* eval = app.add_subcommand("eval", "The paper's experiments");
   eval->require_subcommand(1);
   AddEvalAnnCommand(eval, ann, json);
+  AddEvalEstimatorCommand(eval, estimator, json);
   CLI::App* features = eval->add_subcommand("features", "Feature study (paper Fig. 4): pose error of feature-space neighbours");
   nphand::FeatureStudyOptions& s = o.study;
   features->add_option("--db", o.db, "Database file")->capture_default_str();
@@ -351,7 +379,8 @@ int main(int argc, char** argv) {
   AddIndexCommand(app, index_args);
   nphand::EvalFeaturesCommandOptions eval_options;
   nphand::EvalAnnCommandOptions ann_options;
-  AddEvalCommand(app, eval_options, ann_options, json);
+  nphand::EvalEstimatorCommandOptions estimator_study_options;
+  AddEvalCommand(app, eval_options, ann_options, estimator_study_options, json);
   try {
     CheckSubcommands(app, argc, argv);
     app.parse(argc, argv);

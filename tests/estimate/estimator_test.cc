@@ -102,8 +102,7 @@ TEST_F(EstimatorTest, KeypointsAndDistanceArePlacedInTheFrame) {
   options.fov_deg = 60.0;
   const size_t e = EntryWithoutObject(*db_, 300);
   // The model's own hand length, so that only the camera and the crop decide the distance.
-  const Keypoints3d k = db_->Keypoints(e);
-  options.hand_length_m = (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
+  options.hand_length_m = ModelHandLength(*db_);
   Estimator estimator(*db_, *index_, RightHand(), options);
   const Intrinsics camera = Intrinsics::FromFieldOfView(640, 480, 60 * kDeg);
   // Centred, and off the axis (seen from a turned direction, which the sparse database
@@ -197,16 +196,50 @@ TEST(CombineWithPriorTest, WeightsAreNormalisedAndTwoModesSurviveUntilTheObserva
 }
 
 TEST_F(EstimatorTest, FramesWithoutAHandSaySo) {
-  Estimator estimator(*db_, *index_, RightHand(), Options());
+  EstimatorOptions options = Options();
+  options.skin = SkinOptions{};  // with OpenCV's face cascade
+  Estimator estimator(*db_, *index_, RightHand(), options);
   const cv::Mat wall = MakeBackground(BackgroundKind::kTexture, cv::Size(320, 240), 3);
   FrameResult r = estimator.Process(wall, 0.0);
   EXPECT_EQ(r.status, FrameStatus::kNoSkin);
-  EXPECT_FALSE(r.reason.empty());
+  EXPECT_EQ(r.reason, "no skin-coloured region");
   cv::Mat face = wall.clone();
   DrawFace(SkinToneByName("olive").bgr, cv::Point(160, 110), 160, &face);
-  r = estimator.Process(face, 0.04);
-  EXPECT_FALSE(r.detected()) << "nearest distance " << r.nearest_distance;
+  estimator.Reset();
+  r = estimator.Process(face, 0.0);
+  EXPECT_EQ(r.status, FrameStatus::kNoSkin);
+  EXPECT_EQ(r.reason, "only faces are skin-coloured");
   EXPECT_EQ(estimator.ProcessMask(cv::Mat::zeros(10, 10, CV_8UC1), 0.0).status, FrameStatus::kNoSkin);
+  // A shape no database view resembles is not a hand.
+  options.max_distance = 0.05;
+  Estimator strict(*db_, *index_, RightHand(), options);
+  cv::Mat bar = cv::Mat::zeros(240, 320, CV_8UC1);
+  cv::rectangle(bar, cv::Rect(20, 100, 280, 12), cv::Scalar(255), cv::FILLED);
+  r = strict.ProcessMask(bar, 0.0);
+  EXPECT_EQ(r.status, FrameStatus::kNotAHand);
+  EXPECT_GT(r.nearest_distance, 0.05);
+}
+
+TEST_F(EstimatorTest, AHandBesideAFaceIsFound) {
+  EstimatorOptions options = Options();
+  options.skin = SkinOptions{};
+  Estimator estimator(*db_, *index_, RightHand(), options);
+  SequenceOptions sequence;
+  sequence.frames = 4;
+  sequence.grasp = 13;
+  sequence.face = true;
+  sequence.seed = testing::kTestSeed;
+  Sequence frames(RightHand(), sequence);
+  int found = 0;
+  for (int i = 0; i < frames.size(); ++i) {
+    const SequenceFrame frame = frames.Render(i);
+    const FrameResult r = estimator.Process(frame.rgb, frame.time_s);
+    if (!r.detected()) continue;
+    // The estimate is the hand's: its box holds the hand's pixels, not the face's.
+    const cv::Rect hand = cv::boundingRect(frame.labels == static_cast<int>(PixelLabel::kHand));
+    found += (r.box & hand).area() > 0.5 * hand.area();
+  }
+  EXPECT_GE(found, 3);
 }
 
 TEST_F(EstimatorTest, RenderedSequenceFramesAreEstimatedWithEveryField) {

@@ -154,6 +154,15 @@ bool EstimatorOptions::Check(std::string* why) const {
   return false;
 }
 
+double ModelHandLength(const Database& db) {
+  for (size_t i = 0; i < db.size(); ++i) {
+    if (!db.Meta(i).has_hand) continue;
+    const Keypoints3d k = db.Keypoints(i);
+    return (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
+  }
+  NPHAND_THROW("the database holds no entry with a hand");
+}
+
 Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel& hand, const EstimatorOptions& options)
     : db_(db), index_(index), hand_(hand), options_(options), segmenter_(options.skin), renderer_(hand) {
   std::string why;
@@ -171,12 +180,7 @@ Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel&
   db_distance_ = render["distance_m"].get<double>();
   directions_ = ViewSphereDirections(db.header()["viewpoints"].get<int>());
   grasps_.resize(kNumGrasps + 1);
-  for (size_t i = 0; i < db.size() && model_hand_length_ == 0.0; ++i) {
-    if (!db.Meta(i).has_hand) continue;
-    const Keypoints3d k = db.Keypoints(i);
-    model_hand_length_ = (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
-  }
-  NPHAND_THROW_CHECK(model_hand_length_ > 0.0, "estimator: the database holds no entry with a hand");
+  model_hand_length_ = ModelHandLength(db);
 }
 
 void Estimator::Reset() {
@@ -328,6 +332,16 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   std::vector<Descriptor> descriptors;
   for (const HandCrop& c : crops) descriptors.push_back(DescribeCrop(c, config));
   result.both_turns = crops.size() == 2;
+  {
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(hand_mask(roi).clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+    std::vector<cv::Point> all;
+    for (const auto& c : contours) all.insert(all.end(), c.begin(), c.end());
+    std::vector<cv::Point> hull;
+    if (all.size() >= 3) cv::convexHull(all, hull);
+    const double hull_area = hull.size() >= 3 ? cv::contourArea(hull) : 0.0;
+    result.solidity = hull_area > 0.0 ? std::min(1.0, cv::countNonZero(hand_mask(roi)) / hull_area) : 1.0;
+  }
   result.ms.describe = Ms(t, Clock::now());
 
   t = Clock::now();

@@ -58,7 +58,7 @@ struct EstimatorOptions {
   // ends look alike, so the principal axis's direction is a guess).
   double roll_ambiguity = 0.15;
   // No hand unless the nearest database entry is at most this far in feature space.
-  double max_distance = 0.6;
+  double max_distance = 0.8;
   Handedness hand = Handedness::kRight;         // left: mirrored into the right-hand database
   // Camera: a focal length in pixels, or (focal_px = 0) a horizontal field of view.
   double focal_px = 0.0;
@@ -110,6 +110,7 @@ struct FrameResult {
   std::vector<std::pair<std::string, double>> grasps;   // posterior over grasp names, descending
   std::vector<std::pair<std::string, double>> objects;  // posterior over object shapes ("none": no object)
   double nearest_distance = 0.0;               // the best neighbour's feature distance
+  double solidity = 0.0;                       // the hand's area over its convex hull's
   double effective_samples = 0.0;              // 1 / sum w^2 over the hypotheses
   double confidence = 0.0;                     // the posterior mass near the estimate, 0..1
   StageMilliseconds ms;
@@ -130,6 +131,10 @@ struct WeightedPose {
 std::vector<double> CombineWithPrior(const std::vector<PoseX>& poses, const std::vector<double>& observation,
                                      const std::vector<WeightedPose>& carried, const EstimatorOptions& options,
                                      bool* prior_used);
+
+// The length of the database's hand from the wrist to the middle fingertip along its
+// bones (metres); throws nphand::Error for a database without a hand.
+double ModelHandLength(const Database& db);
 
 class Estimator {
  public:

@@ -1,0 +1,200 @@
+#include "nphand/eval/estimator_study.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <numbers>
+#include <sstream>
+
+#include "nphand/sequence/sequence.h"
+#include "nphand/util/check.h"
+#include "nphand/util/progress.h"
+
+namespace nphand {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
+  std::vector<EstimatorSetting> out;
+  EstimatorOptions nn = base;
+  nn.prior = PriorCombination::kNone;
+  out.push_back({"nn", nn});
+  struct Observation {
+    std::string name;
+    ObservationWeight weight;
+    double sigma_y;
+  };
+  const std::vector<Observation> observations = {
+      {"adaptive", ObservationWeight::kAdaptive, base.sigma_y},
+      {"fixed0.03", ObservationWeight::kFixed, 0.03},
+      {"fixed0.1", ObservationWeight::kFixed, 0.1}};
+  for (const Observation& o : observations) {
+    for (double sigma_x : {0.25, 0.5, 1.0}) {
+      EstimatorOptions e = base;
+      e.observation = o.weight;
+      e.sigma_y = o.sigma_y;
+      e.prior = PriorCombination::kProduct;
+      e.sigma_x = sigma_x;
+      std::ostringstream name;
+      name << o.name << "-product" << sigma_x;
+      out.push_back({name.str(), e});
+    }
+    EstimatorOptions e = base;
+    e.observation = o.weight;
+    e.sigma_y = o.sigma_y;
+    e.prior = PriorCombination::kSum;
+    e.sigma_x = 0.5;
+    out.push_back({o.name + "-sum0.5", e});
+  }
+  for (int carried : {5, 100}) {
+    EstimatorOptions e = base;
+    e.prior = PriorCombination::kProduct;
+    e.carried = carried;
+    out.push_back({"carried" + std::to_string(carried), e});
+  }
+  for (int k : {50, 100}) {
+    EstimatorOptions e = base;
+    e.prior = PriorCombination::kProduct;
+    e.k = k;
+    e.carried = std::min(e.carried, k);
+    out.push_back({"k" + std::to_string(k), e});
+  }
+  return out;
+}
+
+bool EstimatorStudyOptions::Check(std::string* why) const {
+  if (sequences < 1 || sequences > 1000 || frames < 2 || frames > 10000) {
+    *why = "sequences must be within 1..1000 and frames within 2..10000";
+  } else if (width < 64 || height < 64 || width > 4096 || height > 4096) {
+    *why = "the frame size must be within 64..4096 pixels a side";
+  } else {
+    return true;
+  }
+  return false;
+}
+
+std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex& index, const HandModel& hand,
+                                              const EstimatorOptions& base, const EstimatorStudyOptions& options,
+                                              std::ostream* progress) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "estimator study: ", why);
+  std::vector<EstimatorSetting> settings;
+  for (const EstimatorSetting& s : EstimatorSweep(base)) {
+    if (options.settings.empty() || std::find(options.settings.begin(), options.settings.end(), s.name) != options.settings.end()) {
+      settings.push_back(s);
+    }
+  }
+  for (const std::string& name : options.settings) {
+    NPHAND_THROW_CHECK(std::any_of(settings.begin(), settings.end(), [&](const EstimatorSetting& s) { return s.name == name; }),
+                       "estimator study: unknown setting '", name, "'");
+  }
+
+  // The validation frames: sequences that vary everything the estimator must cope with.
+  std::vector<std::vector<SequenceFrame>> sequences;
+  ProgressLine render_line(progress, "estimator study: rendering", static_cast<uint64_t>(options.sequences), "sequences");
+  for (int s = 0; s < options.sequences; ++s) {
+    SequenceOptions sequence;
+    sequence.frames = options.frames;
+    sequence.width = options.width;
+    sequence.height = options.height;
+    sequence.seed = options.seed + static_cast<uint64_t>(s);
+    sequence.forearm = static_cast<ForearmKind>(s % 3 == 2 ? 0 : 1 + s % 2);
+    sequence.background = static_cast<BackgroundKind>((s / 2) % 3);
+    sequence.face = s % 4 == 3;
+    Sequence rendered(hand, sequence);
+    std::vector<SequenceFrame> frames;
+    for (int i = 0; i < rendered.size(); ++i) frames.push_back(rendered.Render(i));
+    sequences.push_back(std::move(frames));
+    render_line.Update(static_cast<uint64_t>(s + 1));
+  }
+  render_line.Finish();
+
+  std::vector<EstimatorScore> scores;
+  ProgressLine line(progress, "estimator study", static_cast<uint64_t>(settings.size()), "settings");
+  for (const EstimatorSetting& setting : settings) {
+    EstimatorOptions e = setting.options;
+    // The truth is the model's hand: compare in its size.
+    e.hand_length_m = ModelHandLength(db);
+    Estimator estimator(db, index, hand, e);
+    EstimatorScore score;
+    score.name = setting.name;
+    score.options = {{"k", e.k},           {"observation", ToString(e.observation)}, {"sigma_y", e.sigma_y},
+                     {"prior", ToString(e.prior)}, {"sigma_x", e.sigma_x}, {"prior_share", e.prior_share},
+                     {"carried", e.carried}};
+    std::vector<double> ms;
+    for (const std::vector<SequenceFrame>& frames : sequences) {
+      estimator.Reset();
+      for (const SequenceFrame& truth : frames) {
+        const FrameResult r = estimator.Process(truth.rgb, truth.time_s);
+        ++score.frames;
+        ms.push_back(r.ms.total);
+        if (!r.detected()) continue;
+        ++score.detected;
+        double joint = 0.0, keypoint = 0.0, px = 0.0, camera = 0.0;
+        for (int d = 0; d < kNumDofs; ++d) joint += std::abs(r.pose.angles[d] - truth.pose.angles[d]);
+        for (int k = 0; k < kNumKeypoints; ++k) {
+          keypoint += (r.keypoints_hand[k] - truth.keypoints[k]).norm();
+          px += (r.keypoints_2d[k] - truth.keypoints_2d[k]).norm();
+          camera += (r.keypoints_camera[k] - (truth.wrist_in_camera + truth.keypoints[k])).norm();
+        }
+        score.joint_deg += joint / kNumDofs * 180.0 / std::numbers::pi;
+        score.wrist_deg += RotationAngleDeg(r.pose.camera_from_hand, truth.pose.camera_from_hand);
+        score.keypoint_mm += 1000.0 * keypoint / kNumKeypoints;
+        score.keypoint_px += px / kNumKeypoints;
+        score.camera_mm += 1000.0 * camera / kNumKeypoints;
+      }
+    }
+    if (score.detected > 0) {
+      for (double* v : {&score.joint_deg, &score.wrist_deg, &score.keypoint_mm, &score.keypoint_px, &score.camera_mm}) {
+        *v /= score.detected;
+      }
+    }
+    score.ms_median = Median(ms);
+    scores.push_back(score);
+    line.Update(scores.size());
+  }
+  line.Finish();
+  return scores;
+}
+
+nlohmann::json ToJson(const std::vector<EstimatorScore>& scores) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const EstimatorScore& s : scores) {
+    rows.push_back({{"name", s.name},
+                    {"options", s.options},
+                    {"frames", s.frames},
+                    {"detected", s.detected},
+                    {"joint_deg", s.joint_deg},
+                    {"wrist_deg", s.wrist_deg},
+                    {"keypoint_mm", s.keypoint_mm},
+                    {"keypoint_px", s.keypoint_px},
+                    {"camera_mm", s.camera_mm},
+                    {"ms_median", s.ms_median}});
+  }
+  return rows;
+}
+
+std::string FormatTable(const std::vector<EstimatorScore>& scores) {
+  std::ostringstream out;
+  out << std::left << std::setw(22) << "setting" << std::right << std::setw(10) << "detected" << std::setw(10)
+      << "joint_deg" << std::setw(10) << "wrist_deg" << std::setw(12) << "keypoint_mm" << std::setw(12) << "keypoint_px"
+      << std::setw(11) << "camera_mm" << std::setw(8) << "ms" << "\n";
+  out << std::fixed;
+  for (const EstimatorScore& s : scores) {
+    out << std::left << std::setw(22) << s.name << std::right << std::setw(10)
+        << (std::to_string(s.detected) + "/" + std::to_string(s.frames)) << std::setprecision(2) << std::setw(10)
+        << s.joint_deg << std::setw(10) << s.wrist_deg << std::setprecision(1) << std::setw(12) << s.keypoint_mm
+        << std::setw(12) << s.keypoint_px << std::setw(11) << s.camera_mm << std::setprecision(2) << std::setw(8)
+        << s.ms_median << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace nphand
