@@ -1,9 +1,17 @@
 #include "apps/bench_command.h"
 
 #include <chrono>
+#include <optional>
 #include <numbers>
 
+#include <sys/resource.h>
+
+#include <algorithm>
+
+#include "nphand/estimate/estimator.h"
+#include "nphand/index/backends.h"
 #include "nphand/render/renderer.h"
+#include "nphand/sequence/sequence.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/util/check.h"
 #include "nphand/util/random.h"
@@ -27,7 +35,89 @@ std::vector<Scene> BenchScenes(const HandModel& model, int count, uint64_t seed)
   return scenes;
 }
 
+double PeakRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes
+}
+
+nlohmann::json Stage(std::vector<double> ms) {
+  std::sort(ms.begin(), ms.end());
+  double sum = 0.0;
+  for (double v : ms) sum += v;
+  return {{"median", ms[ms.size() / 2]}, {"mean", sum / ms.size()}, {"p95", ms[ms.size() * 95 / 100]}};
+}
+
 }  // namespace
+
+bool BenchPipelineOptions::Check(std::string* why) const {
+  if (frames < 1 || frames > 1000000 || width < 64 || height < 64 || width > 4096 || height > 4096 || k < 1) {
+    *why = "bench pipeline needs at least 1 frame, a frame size of 64..4096 a side and k >= 1";
+    return false;
+  }
+  return true;
+}
+
+nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "bench pipeline: ", why);
+  const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+  const Database db = Database::Open(options.db);
+  const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
+  const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
+  EstimatorOptions estimator_options;
+  estimator_options.k = options.k;
+  Estimator estimator(db, *index, hand, estimator_options);
+  const double rss_loaded = PeakRssMb();
+
+  // Frames come from rendered sequences, one at a time (rendering is not timed).
+  constexpr int kWarmUp = 30;
+  constexpr int kPerSequence = 60;
+  std::vector<double> segment, describe, search, weigh, place, total;
+  int detected = 0;
+  std::optional<Sequence> sequence;
+  for (int i = 0; i < kWarmUp + options.frames; ++i) {
+    if (i % kPerSequence == 0) {
+      SequenceOptions s;
+      s.frames = kPerSequence;
+      s.width = options.width;
+      s.height = options.height;
+      s.seed = options.seed + static_cast<uint64_t>(i / kPerSequence);
+      sequence.emplace(hand, s);
+      estimator.Reset();
+    }
+    const SequenceFrame frame = sequence->Render(i % kPerSequence);
+    const FrameResult r = estimator.Process(frame.rgb, frame.time_s);
+    if (i < kWarmUp) continue;
+    detected += r.detected();
+    segment.push_back(r.ms.segment);
+    describe.push_back(r.ms.describe);
+    search.push_back(r.ms.search);
+    weigh.push_back(r.ms.weigh);
+    place.push_back(r.ms.place);
+    total.push_back(r.ms.total);
+  }
+  double total_ms = 0.0;
+  for (double v : total) total_ms += v;
+  return {
+      {"fps", 1000.0 * options.frames / total_ms},
+      {"ms", {{"segment", Stage(segment)}, {"describe", Stage(describe)}, {"search", Stage(search)},
+              {"weigh", Stage(weigh)}, {"place", Stage(place)}, {"total", Stage(total)}}},
+      {"frames", options.frames},
+      {"detected", detected},
+      {"width", options.width},
+      {"height", options.height},
+      {"db_entries", db.size()},
+      {"db_file_mb", db.file_bytes() / 1e6},
+      {"backend", index->Backend()},
+      {"index_mb", index->MemoryBytes() / 1e6},
+      {"k", options.k},
+      {"peak_rss_mb", PeakRssMb()},
+      {"rss_after_load_mb", rss_loaded},
+      {"threads", 1},
+      {"machine", MachineDescription()},
+  };
+}
 
 bool BenchRenderOptions::Check(std::string* why) const {
   if (images < 1 || size < 8 || size > 4096) {

@@ -25,4 +25,24 @@ struct BenchRenderOptions {
 // machine.
 nlohmann::json RunBenchRender(const BenchRenderOptions& options);
 
+// `nphand bench pipeline`: frames per second of the whole estimator on one core: skin
+// segmentation of the frame, the forearm cut, the descriptor, the K-nearest search, the
+// weights and prior, the placement; milliseconds per stage; peak resident memory.
+struct BenchPipelineOptions {
+  std::filesystem::path db = "out/nphand.db";
+  std::filesystem::path index;  // default: the database's path + ".idx"
+  int frames = 300;             // timed (after a warm-up of 30), from rendered sequences
+  int width = 640;
+  int height = 480;
+  int k = 500;
+  uint64_t seed = 1;
+  std::filesystem::path asset_dir = DefaultAssetDir();
+
+  bool Check(std::string* why) const;
+};
+
+// Returns fps, ms per stage (median and mean), peak_rss_mb, db_entries, backend, k, the
+// frame size and the machine.
+nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options);
+
 }  // namespace nphand

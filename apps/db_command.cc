@@ -34,10 +34,24 @@ nlohmann::json RunDbBuild(DbBuildCommandOptions options) {
   std::string why;
   NPHAND_THROW_CHECK(options.build.Check(&why), "db build: ", why);
   CheckOutputFile(options.out, "db build --out");
+  std::string reuse_note;
+  std::error_code error;
+  if (options.reuse && std::filesystem::exists(options.out, error)) {
+    try {
+      const Database existing = Database::Open(options.out);
+      if (existing.header() == options.build.Header()) {
+        return {{"path", options.out.string()}, {"entries", existing.size()}, {"reused", true}};
+      }
+      reuse_note = "the existing file was built with other options";
+    } catch (const Error& e) {
+      reuse_note = std::string("the existing file cannot be used: ") + e.what();
+    }
+  }
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
   const BuildSummary summary = BuildDatabase(hand, options.build, options.out, options.quiet ? nullptr : &std::cerr);
   return {{"path", options.out.string()},     {"entries", summary.entries},         {"resumed", summary.resumed},
-          {"no_hand", summary.no_hand},       {"seconds", summary.seconds},         {"resume_note", summary.resume_note}};
+          {"no_hand", summary.no_hand},       {"seconds", summary.seconds},         {"resume_note", summary.resume_note},
+          {"reused", false},                  {"reuse_note", reuse_note}};
 }
 
 nlohmann::json RunDbMerge(const std::vector<std::filesystem::path>& shards, const std::filesystem::path& out) {

@@ -17,6 +17,7 @@ struct DbBuildCommandOptions {
   std::string shard;  // "i/N" or empty
   std::filesystem::path asset_dir = DefaultAssetDir();
   bool quiet = false;  // no progress line
+  bool reuse = false;  // keep an existing `out` that opens, verifies and has these options' header
 };
 
 // Builds (or resumes) the database; returns {entries, resumed, no_hand, seconds, path}.

@@ -22,7 +22,7 @@ struct EstimateCommandOptions {
   std::filesystem::path out = "out/poses.jsonl";
   std::filesystem::path overlay;          // optional .mp4: the frame with the skeleton, the matched view beside it
   std::string hand = "right";
-  std::string observation = "adaptive";
+  std::string observation = "fixed";
   std::string prior = "product";
   double fps = 30.0;                      // for image folders
   uint64_t max_frames = 0;                // 0: all

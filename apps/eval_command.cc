@@ -40,6 +40,20 @@ AnnStudyResult RunEvalAnn(const EvalAnnCommandOptions& options) {
   return result;
 }
 
+PoseErrorSummary RunEvalPoses(const EvalPosesCommandOptions& options) {
+  if (!options.out_dir.empty()) {
+    CheckFileName(options.name, "eval poses --name");
+    CheckOutputFolder(options.out_dir, "eval poses --out");
+  }
+  const PoseErrorSummary summary = ComparePoses(options.truth, options.poses);
+  if (!options.out_dir.empty()) {
+    WriteFileAtomic(options.out_dir / (options.name + ".json"), ToJson(summary).dump(2) + "\n");
+    WriteImageAtomic(options.out_dir / (options.name + ".png"),
+                     PlotPoseErrors(summary, options.poses.filename().string() + " against " + options.truth.filename().string()));
+  }
+  return summary;
+}
+
 std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& options) {
   std::string why;
   NPHAND_THROW_CHECK(options.study.Check(&why), "eval estimator: ", why);

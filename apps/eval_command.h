@@ -5,6 +5,7 @@
 
 #include "nphand/eval/ann_study.h"
 #include "nphand/eval/estimator_study.h"
+#include "nphand/eval/pose_errors.h"
 #include "nphand/eval/feature_study.h"
 
 namespace nphand {
@@ -38,6 +39,16 @@ struct EvalEstimatorCommandOptions {
   std::string name = "estimator_study";
   EstimatorStudyOptions study;
 };
+
+struct EvalPosesCommandOptions {
+  std::filesystem::path truth;   // truth.jsonl of `nphand sequence`
+  std::filesystem::path poses;   // poses.jsonl of `nphand estimate`
+  std::filesystem::path out_dir; // if set: <name>.json and <name>.png there
+  std::string name = "errors";
+};
+
+// Errors of estimated poses against ground truth (docs/FORMAT.md), frame by frame.
+PoseErrorSummary RunEvalPoses(const EvalPosesCommandOptions& options);
 
 // The estimator's validation sweep (docs/estimator.md).
 std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& options);

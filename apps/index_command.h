@@ -13,6 +13,7 @@ struct IndexBuildCommandOptions {
   std::filesystem::path db = "out/nphand.db";
   std::filesystem::path out;  // default: the database's path with ".idx" appended
   IndexOptions index;
+  bool reuse = false;  // keep an existing `out` that loads for this database with the same backend
 };
 
 // Builds the index and writes it; returns its description, the path and the seconds it took.

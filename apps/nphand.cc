@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
+#include <opencv2/core/utils/logger.hpp>
 
 #include "apps/bench_command.h"
 #include "apps/db_command.h"
@@ -136,9 +137,24 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   });
 }
 
-void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, bool& json) {
+void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::BenchPipelineOptions& p, bool& json) {
   CLI::App* bench = app.add_subcommand("bench", "Measure the speed of a pipeline stage");
   bench->require_subcommand(1);
+  CLI::App* pipeline = bench->add_subcommand(
+      "pipeline", "Frames per second of the whole estimator on one core, ms per stage, peak memory");
+  pipeline->add_option("--db", p.db, "Database file")->capture_default_str();
+  pipeline->add_option("--index", p.index, "Index file (default: the database's path + .idx)");
+  pipeline->add_option("--frames", p.frames, "Frames to time")->capture_default_str();
+  pipeline->add_option("--width", p.width, "Frame width")->capture_default_str();
+  pipeline->add_option("--height", p.height, "Frame height")->capture_default_str();
+  pipeline->add_option("--k", p.k, "Neighbours per frame")->capture_default_str();
+  pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->capture_default_str();
+  pipeline->add_option("--asset-dir", p.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+  pipeline->add_flag("--json", json, "Print one JSON object");
+  pipeline->callback([&p, &json]() {
+    const nlohmann::json report = nphand::RunBenchPipeline(p);
+    std::cout << (json ? report.dump() : report.dump(2)) << "\n";
+  });
   CLI::App* render = bench->add_subcommand("render", "Label images per second (hand + object, one core)");
   render->add_option("--images", o.images, "Images to time")->capture_default_str();
   render->add_option("--size", o.size, "Square image side, pixels")->capture_default_str();
@@ -180,6 +196,7 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
   build->add_option("--shard", a.build.shard, "Build part i of N (i/N), to merge later with db merge");
   build->add_option("--asset-dir", a.build.asset_dir, "Folder holding right.glb")->capture_default_str();
   build->add_flag("--quiet", a.build.quiet, "No progress line");
+  build->add_flag("--reuse", a.build.reuse, "Keep an existing --out built with the same options (after verifying it)");
   build->add_flag("--json", a.json, "Print the summary as one JSON object");
   build->callback([&a]() {
     const nlohmann::json summary = nphand::RunDbBuild(a.build);
@@ -246,6 +263,7 @@ void AddIndexCommand(CLI::App& app, IndexArgs& a) {
   build->add_option("--db", a.build.db, "Database file")->capture_default_str();
   AddIndexOptions(build, a.build.index, a.seed);
   build->add_option("--out", a.build.out, "Index file to write (default: the database's path + .idx)");
+  build->add_flag("--reuse", a.build.reuse, "Keep an existing index of this database with the same backend");
   build->add_flag("--json", a.json, "Print one JSON object");
   build->callback([&a]() {
     a.build.index.lsh.seed = a.build.index.hnsw.seed = a.build.index.ivf.seed = a.seed;
@@ -309,10 +327,24 @@ void AddEvalEstimatorCommand(CLI::App* eval, nphand::EvalEstimatorCommandOptions
   });
 }
 
+void AddEvalPosesCommand(CLI::App* eval, nphand::EvalPosesCommandOptions& o, bool& json) {
+  CLI::App* cmd = eval->add_subcommand("poses", "Errors of estimated poses (poses.jsonl) against ground truth (truth.jsonl)");
+  cmd->add_option("--truth", o.truth, "truth.jsonl of nphand sequence")->required();
+  cmd->add_option("--poses", o.poses, "poses.jsonl of nphand estimate")->required();
+  cmd->add_option("--out", o.out_dir, "Folder for the JSON and the plot");
+  cmd->add_option("--name", o.name, "File name of the JSON and the plot")->capture_default_str();
+  cmd->add_flag("--json", json, "Print JSON (with every frame) instead of the table");
+  cmd->callback([&o, &json]() {
+    const nphand::PoseErrorSummary summary = nphand::RunEvalPoses(o);
+    std::cout << (json ? nphand::ToJson(summary).dump() + "\n" : nphand::FormatTable(summary));
+  });
+}
+
 void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, nphand::EvalAnnCommandOptions& ann,
-                    nphand::EvalEstimatorCommandOptions& estimator, bool& json) {
+                    nphand::EvalEstimatorCommandOptions& estimator, nphand::EvalPosesCommandOptions& poses, bool& json) {
   CLI::App* eval = app.add_subcommand("eval", "The paper's experiments");
   eval->require_subcommand(1);
+  AddEvalPosesCommand(eval, poses, json);
   AddEvalAnnCommand(eval, ann, json);
   AddEvalEstimatorCommand(eval, estimator, json);
   CLI::App* features = eval->add_subcommand("features", "Feature study (paper Fig. 4): pose error of feature-space neighbours");
@@ -362,6 +394,8 @@ void CheckSubcommands(CLI::App& app, int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // nphand reports what went wrong itself; OpenCV's warnings (a failed video back end) are noise.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   CLI::App app{"nphand: non-parametric hand pose estimation with object context"};
   app.require_subcommand(1);
   nphand::RenderCommandOptions render_options;
@@ -372,7 +406,8 @@ int main(int argc, char** argv) {
   AddSequenceCommand(app, sequence_options);
   nphand::EstimateCommandOptions estimate_options;
   AddEstimateCommand(app, estimate_options);
-  AddBenchCommand(app, bench_options, json);
+  nphand::BenchPipelineOptions pipeline_options;
+  AddBenchCommand(app, bench_options, pipeline_options, json);
   DbArgs db_args;
   AddDbCommand(app, db_args);
   IndexArgs index_args;
@@ -380,7 +415,8 @@ int main(int argc, char** argv) {
   nphand::EvalFeaturesCommandOptions eval_options;
   nphand::EvalAnnCommandOptions ann_options;
   nphand::EvalEstimatorCommandOptions estimator_study_options;
-  AddEvalCommand(app, eval_options, ann_options, estimator_study_options, json);
+  nphand::EvalPosesCommandOptions poses_options;
+  AddEvalCommand(app, eval_options, ann_options, estimator_study_options, poses_options, json);
   try {
     CheckSubcommands(app, argc, argv);
     app.parse(argc, argv);

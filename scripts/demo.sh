@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The demo on a fresh machine: installs what is missing, builds, renders a few hand poses
-# with and without objects from several viewpoints, builds the default database and its
-# index, runs small versions of the feature and nearest-neighbour studies, and measures the
-# renderer.
+# with and without objects from several viewpoints, builds (or reuses) the default database
+# and its index, runs small versions of the feature and nearest-neighbour studies, measures
+# the renderer and the whole estimator, and then does the real thing: renders a sequence of
+# a hand with a bare forearm grasping an object the database does not hold, estimates its
+# poses, and writes the JSON lines, the overlay video and the errors against the truth.
 # Everything it writes goes to out/demo/.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -30,14 +32,14 @@ render --name taxonomy --grasp all --azimuth 25 --elevation 25
 render --name power_sphere --grasp power_sphere --azimuth 30 --elevation 10
 
 echo "demo: the default database (33 grasps x 5 steps x with/without object x 648 viewpoints)"
-"$nphand" db build --out "$root/out/nphand.db"
+"$nphand" db build --reuse --out "$root/out/nphand.db"
 "$nphand" db info "$root/out/nphand.db" --json | tee "$out/db_info.json"
 echo
 echo "demo: feature study (paper Fig. 4) on 500 left-out entries, HOG 8x8x8 against pose space"
 "$nphand" eval features --db "$root/out/nphand.db" --queries 500 --features joints,hog8x8x8 --out "$out" --name feature_study
 
 echo "demo: the default index of the database (hnswlib HNSW, chosen in docs/ann_study.md)"
-"$nphand" index build --db "$root/out/nphand.db" --json | tee "$out/index_build.json"
+"$nphand" index build --reuse --db "$root/out/nphand.db" --json | tee "$out/index_build.json"
 echo
 echo "demo: nearest-neighbour study (paper Fig. 5) on 100 held-out renders, exact search against the default"
 "$nphand" eval ann --db "$root/out/nphand.db" --backends exact,hnswlib --fractions 0.25,1 --queries 100 \
@@ -45,4 +47,20 @@ echo "demo: nearest-neighbour study (paper Fig. 5) on 100 held-out renders, exac
 
 echo "demo: renderer speed (label images of 128x128, hand + object, one core)"
 "$nphand" bench render --json | tee "$out/bench_render.json"
+echo "demo: the whole estimator's speed (640x480 frames, K = 500, one core)"
+"$nphand" bench pipeline --json | tee "$out/bench_pipeline.json"
+
+echo "demo: a rendered sequence: a hand with a bare forearm closing onto a cylinder 0.8 times the database's, a rolling camera"
+seq="$out/sequence"
+"$nphand" sequence --grasp 1 --object-scale 0.8 --forearm bare --background clutter --face --frames 120 \
+  --seed 11 --video --out "$seq"
+hand_length=$(sed -n 's/.*"hand_length_m": \([0-9.]*\).*/\1/p' "$seq/sequence.json")
+echo "demo: estimating its poses"
+"$nphand" estimate --db "$root/out/nphand.db" --input "$seq/frames" --hand-length "$hand_length" \
+  --out "$out/poses.jsonl" --overlay "$out/overlay.mp4"
+echo "demo: errors against the ground truth"
+"$nphand" eval poses --truth "$seq/truth.jsonl" --poses "$out/poses.jsonl" --out "$out" --name errors
 echo "demo: done; images in $out"
+echo "  poses:   $out/poses.jsonl (docs/FORMAT.md)"
+echo "  overlay: $out/overlay.mp4"
+echo "  errors:  $out/errors.png, $out/errors.json"

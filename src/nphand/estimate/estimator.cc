@@ -21,15 +21,15 @@ double Ms(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::milli>(to - from).count();
 }
 
-// A hand region together with the pieces an object splits off it: skin regions (not faces)
-// whose boxes meet the region's box grown by 30 % of its longer side.
+// A hand region together with the pieces an object splits off it: skin regions whose boxes
+// meet the region's box grown by 30 % of its longer side.
 cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, cv::Rect* box) {
   const int grow = static_cast<int>(0.3 * std::max(seed.box.width, seed.box.height));
   const cv::Rect reach(seed.box.x - grow, seed.box.y - grow, seed.box.width + 2 * grow, seed.box.height + 2 * grow);
   cv::Mat mask = s.labels == seed.label;
   *box = seed.box;
   for (const SkinRegion& r : s.regions) {
-    if (r.label == seed.label || r.face_overlap >= 0.5 || (r.box & reach).area() == 0) continue;
+    if (r.label == seed.label || (r.box & reach).area() == 0) continue;
     mask |= s.labels == r.label;
     *box |= r.box;
   }
@@ -229,11 +229,9 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
   result.time_s = time_s;
   const SkinSegmentation skin = segmenter_.Segment(bgr);
   std::vector<const SkinRegion*> candidates;
-  for (const SkinRegion& r : skin.regions) {
-    if (r.face_overlap < 0.5) candidates.push_back(&r);
-  }
+  for (const SkinRegion& r : skin.regions) candidates.push_back(&r);
   // Larger and nearer the last hand first.
-  const double spread = 0.3 * std::hypot(bgr.cols, bgr.rows);
+  const double spread = 0.2 * std::hypot(bgr.cols, bgr.rows);
   auto score = [&](const SkinRegion* r) {
     double s = r->area;
     if (last_centre_.has_value()) {
@@ -247,7 +245,7 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
   result.ms.segment = Ms(start, Clock::now());
   if (candidates.empty()) {
     result.status = FrameStatus::kNoSkin;
-    result.reason = skin.regions.empty() ? "no skin-coloured region" : "only faces are skin-coloured";
+    result.reason = skin.face_pixels > 0 ? "only faces are skin-coloured" : "no skin-coloured region";
     carried_.clear();
     result.ms.total = Ms(start, Clock::now());
     return result;

@@ -47,8 +47,9 @@ PriorCombination PriorCombinationFromString(const std::string& text);
 
 struct EstimatorOptions {
   int k = 500;                                  // neighbours searched (the paper's K)
-  ObservationWeight observation = ObservationWeight::kAdaptive;
-  double sigma_y = 0.05;                        // kFixed: feature-distance scale (L2 of the descriptor)
+  // The defaults are the validation sweep's best (docs/estimator.md, `nphand eval estimator`).
+  ObservationWeight observation = ObservationWeight::kFixed;
+  double sigma_y = 0.1;                         // kFixed: feature-distance scale (L2 of the descriptor)
   PriorCombination prior = PriorCombination::kProduct;
   double sigma_x = 0.5;                         // the prior's kernel width in pose-vector units
   double prior_share = 0.9;                     // kSum's weight on the prior

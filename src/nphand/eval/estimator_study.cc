@@ -34,7 +34,8 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
   const std::vector<Observation> observations = {
       {"adaptive", ObservationWeight::kAdaptive, base.sigma_y},
       {"fixed0.03", ObservationWeight::kFixed, 0.03},
-      {"fixed0.1", ObservationWeight::kFixed, 0.1}};
+      {"fixed0.1", ObservationWeight::kFixed, 0.1},
+      {"fixed0.2", ObservationWeight::kFixed, 0.2}};
   for (const Observation& o : observations) {
     for (double sigma_x : {0.25, 0.5, 1.0}) {
       EstimatorOptions e = base;

@@ -57,6 +57,8 @@ void SkinSegmenter::Reset() {
   rest_hist_ = cv::Mat::zeros(options_.bins, options_.bins, CV_32FC1);
   learned_ = 0;
   frames_ = 0;
+  last_regions_ = -1;
+  regions_changed_ = false;
   faces_.clear();
   RebuildLookup();
 }
@@ -103,7 +105,13 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
                      cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(options_.close_px, options_.close_px)));
   }
 
-  if (detector_ != nullptr && frames_ % options_.face_interval == 0) {
+  // Faces: looked for every face_interval frames, and at once when the regions changed in
+  // number on the last frame (someone came into view); the cascade costs more than the rest
+  // of the frame. A face's skin (the head's ellipse and the neck below it) is set aside
+  // before the regions are found, so that a hand in front of a face keeps the rest of itself.
+  const bool look = frames_ % options_.face_interval == 0 || regions_changed_;
+  ++frames_;
+  if (detector_ != nullptr && look) {
     cv::Mat grey;
     cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
     double scale = 1.0;
@@ -120,8 +128,18 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
                           static_cast<int>(f.height * scale));
     }
   }
-  ++frames_;
   out.faces = faces_;
+  if (!faces_.empty()) {
+    cv::Mat face_mask = cv::Mat::zeros(bgr.size(), CV_8UC1);
+    for (const cv::Rect& f : faces_) {
+      const cv::Point centre(f.x + f.width / 2, f.y + f.height / 2);
+      cv::ellipse(face_mask, centre, cv::Size(f.width * 7 / 10, f.height * 9 / 10), 0, 0, 360, cv::Scalar(255), cv::FILLED);
+      cv::rectangle(face_mask, cv::Rect(f.x + f.width / 5, centre.y, f.width * 3 / 5, f.height * 3 / 2), cv::Scalar(255),
+                    cv::FILLED);
+    }
+    out.face_pixels = cv::countNonZero(out.skin & face_mask);
+    out.skin.setTo(0, face_mask);
+  }
 
   cv::Mat stats, centroids;
   const int count = cv::connectedComponentsWithStats(out.skin, out.labels, stats, centroids, 8, CV_32S);
@@ -134,14 +152,10 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     region.box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
                           stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
     region.centroid = cv::Point2d(centroids.at<double>(label, 0), centroids.at<double>(label, 1));
-    int in_faces = 0;
-    for (const cv::Rect& face : faces_) {
-      const cv::Rect overlap = face & region.box;
-      if (overlap.area() > 0) in_faces += cv::countNonZero(out.labels(overlap) == label);
-    }
-    region.face_overlap = std::min(1.0, static_cast<double>(in_faces) / region.area);
     out.regions.push_back(region);
   }
+  regions_changed_ = static_cast<int>(out.regions.size()) != last_regions_;
+  last_regions_ = static_cast<int>(out.regions.size());
   std::sort(out.regions.begin(), out.regions.end(),
             [](const SkinRegion& a, const SkinRegion& b) { return a.area != b.area ? a.area > b.area : a.label < b.label; });
   return out;

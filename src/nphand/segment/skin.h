@@ -32,11 +32,11 @@ struct SkinOptions {
   int open_px = 3;              // opening removes specks (0: none)
   int close_px = 5;             // closing fills cracks; holes wider than this stay (the object's)
   double min_area = 0.0003;     // smallest region, as a fraction of the frame (fingertips past an object count)
-  // Faces: the cascade's file ("" finds none), run every face_interval frames on a frame
-  // halved until it is at most 320 pixels wide; skin regions mostly inside a face are not
-  // hand candidates.
+  // Faces: the cascade's file ("" finds none), run every face_interval frames and whenever
+  // the skin regions changed in number, on a frame halved until it is at most 320 pixels
+  // wide; each face's head and neck are set aside from the skin.
   std::string face_cascade = kDefaultFaceCascade;
-  int face_interval = 10;
+  int face_interval = 30;
   bool Check(std::string* why) const;
 };
 
@@ -45,14 +45,14 @@ struct SkinRegion {
   cv::Rect box;
   int area = 0;               // pixels
   cv::Point2d centroid;
-  double face_overlap = 0.0;  // the share of its pixels inside a detected face
 };
 
 struct SkinSegmentation {
-  cv::Mat skin;                     // CV_8UC1, 255 = skin (cleaned)
+  cv::Mat skin;                     // CV_8UC1, 255 = skin (cleaned, faces set aside)
   cv::Mat labels;                   // CV_32SC1, connected regions of `skin` (0: none)
   std::vector<SkinRegion> regions;  // at least min_area, largest first
   std::vector<cv::Rect> faces;      // the faces in view (the last detection's)
+  int face_pixels = 0;              // skin pixels set aside as faces (heads and necks)
   // The pixels of one region within its box (CV_8UC1, 255 = the region).
   cv::Mat RegionMask(const SkinRegion& region) const;
 };
@@ -80,6 +80,8 @@ class SkinSegmenter {
   cv::Mat hand_hist_, rest_hist_;  // CV_32FC1, bins x bins, each summing to 1
   int learned_ = 0;
   int frames_ = 0;
+  int last_regions_ = -1;
+  bool regions_changed_ = false;
   std::vector<cv::Rect> faces_;
   struct FaceDetector;
   std::shared_ptr<FaceDetector> detector_;

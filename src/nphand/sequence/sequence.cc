@@ -129,11 +129,20 @@ Sequence::Sequence(const HandModel& hand, const SequenceOptions& options)
                       static_cast<int>(options.height * (1.0 + 2.0 * kPanMargin)));
   background_ = MakeBackground(options.background, size, random.Next());
   if (options.face) {
-    const int height = options.height / 2;
-    const int side = random.Uniform() < 0.5 ? 1 : -1;
-    DrawFace(skin_bgr_, cv::Point(size.width / 2 + side * size.width * 3 / 10, size.height * 2 / 5), height,
-             &background_);
+    // A person behind the hand: wholly in view whatever the pan, on the side the hand's
+    // sideways motion (Render) visits less. A hand passing in front of a face is not
+    // rendered: the skin model would take hand and face for one region.
+    double drift = 0.0;
+    for (int i = 0; i <= 100; ++i) drift += std::sin(1.3 * std::numbers::pi * i / 100.0 + phases_[2]);
+    const int height = options.height * 2 / 5;
+    const int side = drift > 0.0 ? -1 : 1;
+    DrawFace(skin_bgr_, cv::Point(size.width / 2 + side * size.width / 4, size.height * 2 / 5), height, &background_);
   }
+}
+
+double Sequence::hand_length_m() const {
+  const Keypoints3d k = hand_.KeypointsOf(HandPose{});
+  return (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
 }
 
 JointAngles Sequence::AnglesAt(double step) const {
@@ -244,6 +253,7 @@ nlohmann::json Sequence::Describe() const {
           {"turn_deg", options_.turn_deg},
           {"roll_deg", options_.roll_deg},
           {"distance_m", options_.distance_m},
+          {"hand_length_m", hand_length_m()},
           {"noise", options_.noise},
           {"seed", options_.seed},
           {"light_direction", ToVector(light_)}};

@@ -89,6 +89,9 @@ class Sequence {
   int grasp() const { return grasp_.id; }
   const ObjectSpec& object() const { return grasp_.object.spec; }
   const std::string& skin() const { return skin_; }
+  // The rendered hand's length from the wrist to the middle fingertip along its bones, metres
+  // (for `nphand estimate --hand-length`).
+  double hand_length_m() const;
 
   // Frame `i` (0 <= i < size()): the same bytes for the same options.
   SequenceFrame Render(int i);

@@ -1,0 +1,210 @@
+#include "nphand/eval/pose_errors.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <numbers>
+#include <sstream>
+
+#include <Eigen/Core>
+#include <opencv2/imgproc.hpp>
+
+#include "nphand/model/hand_pose.h"
+#include "nphand/model/skeleton.h"
+#include "nphand/util/check.h"
+
+namespace nphand {
+namespace {
+
+constexpr std::array<const char*, 5> kMeasures = {"joint_deg", "wrist_deg", "keypoint_mm", "keypoint_px", "camera_mm"};
+
+std::vector<nlohmann::json> ReadLines(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  NPHAND_THROW_CHECK(in.good(), path.string(), ": cannot read");
+  std::vector<nlohmann::json> lines;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty()) continue;
+    try {
+      lines.push_back(nlohmann::json::parse(line));
+    } catch (const nlohmann::json::exception& e) {
+      NPHAND_THROW(path.string(), ":", number, ": not a JSON object (", e.what(), ")");
+    }
+    NPHAND_THROW_CHECK(lines.back().is_object(), path.string(), ":", number, ": not a JSON object");
+  }
+  NPHAND_THROW_CHECK(!lines.empty(), path.string(), ": no lines");
+  return lines;
+}
+
+template <typename T>
+T Field(const nlohmann::json& line, const char* key, const std::filesystem::path& path, size_t index) {
+  try {
+    return line.at(key).get<T>();
+  } catch (const nlohmann::json::exception&) {
+    NPHAND_THROW(path.string(), ": line ", index + 1, " has no valid '", key, "'");
+  }
+}
+
+using Points3 = std::vector<std::array<double, 3>>;
+using Points2 = std::vector<std::array<double, 2>>;
+
+double ChainLength(const Points3& k) {
+  auto d = [&](int a, int b) { return std::hypot(k[a][0] - k[b][0], k[a][1] - k[b][1], k[a][2] - k[b][2]); };
+  return d(0, 9) + d(9, 10) + d(10, 11) + d(11, 12);
+}
+
+double Mean(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / v.size();
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std::filesystem::path& poses_path) {
+  const std::vector<nlohmann::json> truth = ReadLines(truth_path), poses = ReadLines(poses_path);
+  NPHAND_THROW_CHECK(poses.size() <= truth.size(), poses_path.string(), " has ", poses.size(), " frames, ",
+                     truth_path.string(), " only ", truth.size());
+  PoseErrorSummary summary;
+  std::array<std::vector<double>, kMeasures.size()> values;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const nlohmann::json& p = poses[i];
+    const nlohmann::json& t = truth[i];
+    FramePoseError e;
+    e.frame = Field<int>(p, "frame", poses_path, i);
+    NPHAND_THROW_CHECK(e.frame == Field<int>(t, "frame", truth_path, i), poses_path.string(), ": line ", i + 1,
+                       " is frame ", e.frame, " but the truth's line is another frame");
+    e.detected = Field<bool>(p, "detected", poses_path, i);
+    if (e.detected) {
+      const auto true_angles = Field<std::map<std::string, double>>(t, "joint_angles_deg", truth_path, i);
+      const auto angles = Field<std::map<std::string, double>>(p, "joint_angles_deg", poses_path, i);
+      for (const auto& [name, deg] : true_angles) {
+        const auto it = angles.find(name);
+        NPHAND_THROW_CHECK(it != angles.end(), poses_path.string(), ": line ", i + 1, " has no angle '", name, "'");
+        e.joint_deg += std::abs(it->second - deg) / true_angles.size();
+      }
+      const auto r1 = Field<std::array<std::array<double, 3>, 3>>(p, "wrist_rotation", poses_path, i);
+      const auto r2 = Field<std::array<std::array<double, 3>, 3>>(t, "wrist_rotation", truth_path, i);
+      Eigen::Matrix3d a, b;
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+          a(r, c) = r1[r][c];
+          b(r, c) = r2[r][c];
+        }
+      }
+      e.wrist_deg = RotationAngleDeg(a, b);
+      const Points3 kh = Field<Points3>(p, "keypoints_3d_hand_m", poses_path, i);
+      const Points3 th = Field<Points3>(t, "keypoints_3d_hand_m", truth_path, i);
+      const Points3 kc = Field<Points3>(p, "keypoints_3d_camera_m", poses_path, i);
+      const Points3 tc = Field<Points3>(t, "keypoints_3d_camera_m", truth_path, i);
+      const Points2 k2 = Field<Points2>(p, "keypoints_2d_px", poses_path, i);
+      const Points2 t2 = Field<Points2>(t, "keypoints_2d_px", truth_path, i);
+      NPHAND_THROW_CHECK(kh.size() == kNumKeypoints && th.size() == kNumKeypoints && kc.size() == kNumKeypoints &&
+                             tc.size() == kNumKeypoints && k2.size() == kNumKeypoints && t2.size() == kNumKeypoints,
+                         poses_path.string(), ": line ", i + 1, ": keypoints must be 21");
+      const double scale = ChainLength(th) / std::max(ChainLength(kh), 1e-9);
+      for (int k = 0; k < kNumKeypoints; ++k) {
+        e.keypoint_mm += 1000.0 * std::hypot(scale * kh[k][0] - th[k][0], scale * kh[k][1] - th[k][1], scale * kh[k][2] - th[k][2]) / kNumKeypoints;
+        e.camera_mm += 1000.0 * std::hypot(kc[k][0] - tc[k][0], kc[k][1] - tc[k][1], kc[k][2] - tc[k][2]) / kNumKeypoints;
+        e.keypoint_px += std::hypot(k2[k][0] - t2[k][0], k2[k][1] - t2[k][1]) / kNumKeypoints;
+      }
+      ++summary.detected;
+      const std::array<double, kMeasures.size()> row = {e.joint_deg, e.wrist_deg, e.keypoint_mm, e.keypoint_px, e.camera_mm};
+      for (size_t m = 0; m < row.size(); ++m) values[m].push_back(row[m]);
+    }
+    summary.frames.push_back(e);
+  }
+  for (const std::vector<double>& v : values) {
+    summary.mean.push_back(Mean(v));
+    summary.median.push_back(Median(v));
+  }
+  return summary;
+}
+
+nlohmann::json ToJson(const PoseErrorSummary& summary) {
+  nlohmann::json mean = nlohmann::json::object(), median = nlohmann::json::object();
+  for (size_t m = 0; m < kMeasures.size(); ++m) {
+    mean[kMeasures[m]] = summary.mean[m];
+    median[kMeasures[m]] = summary.median[m];
+  }
+  nlohmann::json frames = nlohmann::json::array();
+  for (const FramePoseError& e : summary.frames) {
+    nlohmann::json f = {{"frame", e.frame}, {"detected", e.detected}};
+    if (e.detected) {
+      f["joint_deg"] = e.joint_deg;
+      f["wrist_deg"] = e.wrist_deg;
+      f["keypoint_mm"] = e.keypoint_mm;
+      f["keypoint_px"] = e.keypoint_px;
+      f["camera_mm"] = e.camera_mm;
+    }
+    frames.push_back(f);
+  }
+  return {{"frames", summary.frames.size()}, {"detected", summary.detected}, {"mean", mean}, {"median", median},
+          {"per_frame", frames}};
+}
+
+std::string FormatTable(const PoseErrorSummary& summary) {
+  std::ostringstream out;
+  out << "detected " << summary.detected << " of " << summary.frames.size() << " frames\n";
+  out << std::left << std::setw(14) << "measure" << std::right << std::setw(10) << "mean" << std::setw(10) << "median" << "\n";
+  out << std::fixed << std::setprecision(2);
+  for (size_t m = 0; m < kMeasures.size(); ++m) {
+    out << std::left << std::setw(14) << kMeasures[m] << std::right << std::setw(10) << summary.mean[m] << std::setw(10)
+        << summary.median[m] << "\n";
+  }
+  return out.str();
+}
+
+cv::Mat PlotPoseErrors(const PoseErrorSummary& summary, const std::string& title) {
+  const int width = 900, panel = 170, left = 70, right = 20, top = 40;
+  const std::array<int, 3> shown = {0, 1, 2};  // joint_deg, wrist_deg, keypoint_mm
+  const std::array<const char*, 3> labels = {"joint angle error, deg", "wrist rotation error, deg",
+                                             "3D keypoint error about the wrist, mm"};
+  cv::Mat plot(top + panel * static_cast<int>(shown.size()) + 30, width, CV_8UC3, cv::Scalar(255, 255, 255));
+  const cv::Scalar black(0, 0, 0), blue(180, 90, 20), red(60, 60, 220);
+  cv::putText(plot, title, {left, 25}, cv::FONT_HERSHEY_SIMPLEX, 0.6, black, 1, cv::LINE_AA);
+  const size_t n = std::max<size_t>(summary.frames.size(), 2);
+  const auto x_of = [&](size_t i) { return left + static_cast<int>((width - left - right) * i / (n - 1)); };
+  for (size_t s = 0; s < shown.size(); ++s) {
+    const int y0 = top + static_cast<int>(s) * panel, y1 = y0 + panel - 30;
+    double high = 1.0;
+    for (const FramePoseError& e : summary.frames) {
+      const std::array<double, 3> v = {e.joint_deg, e.wrist_deg, e.keypoint_mm};
+      if (e.detected) high = std::max(high, v[s]);
+    }
+    high = std::ceil(high);
+    cv::line(plot, {left, y1}, {width - right, y1}, black);
+    cv::line(plot, {left, y0}, {left, y1}, black);
+    cv::putText(plot, labels[s], {left + 8, y0 + 14}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black, 1, cv::LINE_AA);
+    cv::putText(plot, cv::format("%.0f", high), {8, y0 + 10}, cv::FONT_HERSHEY_SIMPLEX, 0.42, black);
+    cv::putText(plot, "0", {8, y1}, cv::FONT_HERSHEY_SIMPLEX, 0.42, black);
+    std::vector<cv::Point> line;
+    for (size_t i = 0; i < summary.frames.size(); ++i) {
+      const FramePoseError& e = summary.frames[i];
+      if (!e.detected) {
+        cv::line(plot, {x_of(i), y1 - 6}, {x_of(i), y1}, red, 1);
+        if (line.size() > 1) cv::polylines(plot, line, false, blue, 1, cv::LINE_AA);
+        line.clear();
+        continue;
+      }
+      const std::array<double, 3> v = {e.joint_deg, e.wrist_deg, e.keypoint_mm};
+      line.emplace_back(x_of(i), y1 - static_cast<int>((y1 - y0 - 20) * v[s] / high));
+    }
+    if (line.size() > 1) cv::polylines(plot, line, false, blue, 1, cv::LINE_AA);
+  }
+  cv::putText(plot, "frame (red ticks: no hand reported)", {width / 2 - 120, plot.rows - 8}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+              black, 1, cv::LINE_AA);
+  return plot;
+}
+
+}  // namespace nphand

@@ -1,0 +1,44 @@
+// Errors of estimated poses against ground truth, frame by frame: what `nphand estimate`
+// wrote (poses.jsonl) against what `nphand sequence` rendered (truth.jsonl), in the paper's
+// measures (joint angles; 3D joint positions about the wrist, which the paper prefers, Fig. 8)
+// and today's (wrist rotation, 2D keypoints in pixels, 3D keypoints in the camera frame).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+namespace nphand {
+
+struct FramePoseError {
+  int frame = 0;
+  bool detected = false;
+  double joint_deg = 0.0;    // mean absolute joint-angle error
+  double wrist_deg = 0.0;    // angle of the rotation between estimated and true wrist rotations
+  double keypoint_mm = 0.0;  // mean 3D keypoint distance about the wrist, estimate scaled to the truth's hand length
+  double keypoint_px = 0.0;  // mean 2D keypoint distance in the frame
+  double camera_mm = 0.0;    // mean 3D keypoint distance in the camera frame
+};
+
+struct PoseErrorSummary {
+  std::vector<FramePoseError> frames;
+  int detected = 0;
+  // Over detected frames: mean and median of each measure, in the order joint_deg,
+  // wrist_deg, keypoint_mm, keypoint_px, camera_mm.
+  std::vector<double> mean, median;
+};
+
+// Reads both files (one JSON object per line, the same frames in the same order) and
+// compares them. Throws nphand::Error naming the file and line of anything missing or
+// mismatched.
+PoseErrorSummary ComparePoses(const std::filesystem::path& truth, const std::filesystem::path& poses);
+
+nlohmann::json ToJson(const PoseErrorSummary& summary);
+std::string FormatTable(const PoseErrorSummary& summary);
+// The errors over the frames: one panel per measure, undetected frames marked.
+cv::Mat PlotPoseErrors(const PoseErrorSummary& summary, const std::string& title);
+
+}  // namespace nphand

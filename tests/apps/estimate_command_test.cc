@@ -1,0 +1,213 @@
+#include "apps/estimate_command.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "apps/bench_command.h"
+#include "apps/db_command.h"
+#include "apps/eval_command.h"
+#include "apps/index_command.h"
+#include "apps/sequence_command.h"
+#include "nphand/util/check.h"
+#include "testing/testing.h"
+#include "testing/tiny_db.h"
+
+namespace nphand {
+namespace {
+
+std::vector<nlohmann::json> Lines(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::vector<nlohmann::json> lines;
+  std::string line;
+  while (std::getline(in, line)) lines.push_back(nlohmann::json::parse(line));
+  return lines;
+}
+
+// A tiny database with an exact index, and a short rendered sequence, shared by the suite.
+class EstimateCommandTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::filesystem::path(std::filesystem::temp_directory_path() /
+                                     ("nphand_estimate_command_" + std::to_string(::getpid())));
+    std::filesystem::remove_all(*dir_);
+    std::filesystem::create_directories(*dir_);
+    testing::BuildTinyDatabase(*dir_ / "tiny.db");
+    IndexBuildCommandOptions index;
+    index.db = *dir_ / "tiny.db";
+    index.index = IndexOptions::Exact();
+    RunIndexBuild(index);
+    SequenceCommandOptions sequence;
+    sequence.sequence.frames = 5;
+    sequence.sequence.width = 240;
+    sequence.sequence.height = 180;
+    sequence.sequence.grasp = 1;
+    sequence.sequence.distance_m = 0.3;
+    sequence.video = true;
+    sequence.out_dir = *dir_ / "sequence";
+    RunSequence(sequence, nullptr);
+  }
+  static void TearDownTestSuite() {
+    std::filesystem::remove_all(*dir_);
+    delete dir_;
+  }
+  static EstimateCommandOptions Options() {
+    EstimateCommandOptions options;
+    options.db = *dir_ / "tiny.db";
+    options.input = (*dir_ / "sequence" / "frames").string();
+    options.out = *dir_ / "poses.jsonl";
+    options.faces = false;
+    options.estimator.k = 40;
+    options.estimator.max_distance = 2.0;  // the tiny database's views are far apart
+    return options;
+  }
+  static inline std::filesystem::path* dir_ = nullptr;
+};
+
+TEST_F(EstimateCommandTest, SequenceFilesAreWritten) {
+  for (const char* name : {"frames/000004.png", "labels/000004.png", "truth.jsonl", "sequence.json", "video.mp4"}) {
+    EXPECT_TRUE(std::filesystem::exists(*dir_ / "sequence" / name)) << name;
+  }
+  EXPECT_EQ(Lines(*dir_ / "sequence" / "truth.jsonl").size(), 5u);
+}
+
+TEST_F(EstimateCommandTest, AFolderGivesOneLinePerFrameWithEveryFieldAndAnOverlay) {
+  EstimateCommandOptions options = Options();
+  options.overlay = *dir_ / "overlay.mp4";
+  options.top = true;
+  const nlohmann::json summary = RunEstimate(options, nullptr, nullptr);
+  EXPECT_EQ(summary["frames"], 5);
+  EXPECT_EQ(summary["input_kind"], "folder");
+  EXPECT_TRUE(std::filesystem::exists(options.overlay));
+  EXPECT_FALSE(std::filesystem::exists(options.out.string() + ".partial"));
+  const std::vector<nlohmann::json> lines = Lines(options.out);
+  ASSERT_EQ(lines.size(), 5u);
+  int detected = 0;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const nlohmann::json& line = lines[i];
+    EXPECT_EQ(line["frame"], i);
+    EXPECT_EQ(line["image"], cv::format("%06zu.png", i));
+    for (const char* key : {"time_s", "detected", "status", "ms"}) EXPECT_TRUE(line.contains(key)) << key;
+    if (!line["detected"].get<bool>()) continue;
+    ++detected;
+    for (const char* key : {"hand", "wrist_rotation", "wrist_quaternion_wxyz", "joint_angles_deg", "pose_vector",
+                            "keypoints_2d_px", "keypoints_3d_hand_m", "keypoints_3d_camera_m", "depth_m", "box_px",
+                            "grasps", "objects", "confidence", "effective_samples", "nearest_distance", "top"}) {
+      EXPECT_TRUE(line.contains(key)) << key;
+    }
+    EXPECT_EQ(line["keypoints_2d_px"].size(), 21u);
+    EXPECT_EQ(line["joint_angles_deg"].size(), 21u);
+    EXPECT_EQ(line["pose_vector"].size(), 30u);
+  }
+  EXPECT_GE(detected, 4);
+  // And the errors against the truth.
+  EvalPosesCommandOptions eval;
+  eval.truth = *dir_ / "sequence" / "truth.jsonl";
+  eval.poses = options.out;
+  eval.out_dir = *dir_ / "errors";
+  const PoseErrorSummary errors = RunEvalPoses(eval);
+  EXPECT_EQ(errors.frames.size(), 5u);
+  EXPECT_EQ(errors.detected, detected);
+  EXPECT_TRUE(std::filesystem::exists(*dir_ / "errors" / "errors.png"));
+}
+
+TEST_F(EstimateCommandTest, AStopLeavesCompleteLinesAndMaxFramesStops) {
+  EstimateCommandOptions options = Options();
+  options.max_frames = 2;
+  EXPECT_EQ(RunEstimate(options, nullptr, nullptr)["frames"], 2);
+  EXPECT_EQ(Lines(options.out).size(), 2u);
+  const std::atomic<bool> stop{true};
+  const nlohmann::json summary = RunEstimate(Options(), nullptr, &stop);
+  EXPECT_TRUE(summary["stopped"].get<bool>());
+  EXPECT_TRUE(std::filesystem::exists(Options().out));
+  EXPECT_TRUE(Lines(Options().out).empty());
+}
+
+TEST_F(EstimateCommandTest, BadInputsGiveTheirErrors) {
+  EstimateCommandOptions options = Options();
+  options.db = *dir_ / "missing.db";
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "no database there");
+  options = Options();
+  options.index = *dir_ / "missing.idx";
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "no index there");
+  options = Options();
+  options.input = (*dir_ / "nothing").string();
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "no such file or folder");
+  std::filesystem::create_directories(*dir_ / "empty");
+  options.input = (*dir_ / "empty").string();
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "no images in this folder");
+  {
+    std::ofstream(*dir_ / "not_a_video.mp4") << "hello";
+  }
+  options.input = (*dir_ / "not_a_video.mp4").string();
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "not_a_video.mp4");
+  options.input = "97";
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "camera 97 is not there");
+  // An index of another database.
+  options = Options();
+  const std::filesystem::path other = testing::BuildTinyDatabase(*dir_ / "other.db");
+  DatabaseBuildOptions different = testing::TinyDatabaseOptions();
+  different.directions = 12;
+  BuildDatabase(testing::RightHand(), different, other, nullptr);
+  IndexBuildCommandOptions index;
+  index.db = other;
+  index.index = IndexOptions::Exact();
+  RunIndexBuild(index);
+  options.index = other.string() + ".idx";
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "another database");
+  options = Options();
+  options.prior = "max";
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "none, product or sum");
+  // Truth and poses that do not belong together.
+  {
+    std::ofstream(*dir_ / "broken.jsonl") << "{\"frame\": 0, \"detected\": true}\n";
+  }
+  EvalPosesCommandOptions eval;
+  eval.truth = *dir_ / "sequence" / "truth.jsonl";
+  eval.poses = *dir_ / "broken.jsonl";
+  testing::ExpectError([&] { RunEvalPoses(eval); }, "has no valid 'joint_angles_deg'");
+}
+
+TEST_F(EstimateCommandTest, ReuseKeepsAMatchingDatabaseAndIndex) {
+  DbBuildCommandOptions db;
+  db.out = *dir_ / "tiny.db";
+  db.build = testing::TinyDatabaseOptions();
+  db.reuse = true;
+  db.quiet = true;
+  EXPECT_TRUE(RunDbBuild(db)["reused"].get<bool>());
+  db.build.directions = 9;
+  db.out = *dir_ / "reuse.db";
+  std::filesystem::copy_file(*dir_ / "tiny.db", db.out);
+  const nlohmann::json rebuilt = RunDbBuild(db);
+  EXPECT_FALSE(rebuilt["reused"].get<bool>());
+  EXPECT_EQ(rebuilt["reuse_note"], "the existing file was built with other options");
+  IndexBuildCommandOptions index;
+  index.db = *dir_ / "tiny.db";
+  index.index = IndexOptions::Exact();
+  index.reuse = true;
+  EXPECT_TRUE(RunIndexBuild(index)["reused"].get<bool>());
+}
+
+TEST_F(EstimateCommandTest, BenchPipelineReportsEveryFigure) {
+  BenchPipelineOptions options;
+  options.db = *dir_ / "tiny.db";
+  options.frames = 3;
+  options.width = 240;
+  options.height = 180;
+  options.k = 20;
+  const nlohmann::json report = RunBenchPipeline(options);
+  for (const char* key : {"fps", "ms", "peak_rss_mb", "db_entries", "backend", "k", "machine"}) {
+    EXPECT_TRUE(report.contains(key)) << key;
+  }
+  for (const char* stage : {"segment", "describe", "search", "weigh", "place", "total"}) {
+    EXPECT_TRUE(report["ms"].contains(stage)) << stage;
+  }
+  EXPECT_EQ(report["backend"], "exact");
+  EXPECT_GT(report["fps"].get<double>(), 0.0);
+}
+
+}  // namespace
+}  // namespace nphand
