@@ -53,7 +53,7 @@ struct EstimatorOptions {
   PriorCombination prior = PriorCombination::kProduct;
   double sigma_x = 0.5;                         // the prior's kernel width in pose-vector units
   double prior_share = 0.9;                     // kSum's weight on the prior
-  int carried = 20;                             // hypotheses carried to the next frame
+  int carried = 5;                              // hypotheses carried to the next frame
   int top_n = 5;                                // hypotheses in each result
   // Search the half-turned crop too when the silhouette's skewness is below this (its two
   // ends look alike, so the principal axis's direction is a guess).

@@ -54,7 +54,7 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     e.sigma_x = 0.5;
     out.push_back({o.name + "-sum0.5", e});
   }
-  for (int carried : {5, 100}) {
+  for (int carried : {20, 100}) {
     EstimatorOptions e = base;
     e.prior = PriorCombination::kProduct;
     e.carried = carried;

@@ -1,0 +1,85 @@
+// Google Benchmark of the estimator's stages that need no database: skin segmentation of a
+// 640x480 camera-like frame, the forearm cut, the descriptor of the hand's crop, and the
+// temporal prior over K = 500 hypotheses. The whole path, search included, is `nphand bench
+// pipeline`; the search alone is index_bench.
+#include <benchmark/benchmark.h>
+#include <opencv2/imgproc.hpp>
+
+#include "nphand/estimate/estimator.h"
+#include "nphand/features/descriptor.h"
+#include "nphand/segment/forearm.h"
+#include "nphand/segment/skin.h"
+#include "nphand/sequence/sequence.h"
+#include "nphand/util/random.h"
+
+namespace nphand {
+namespace {
+
+const SequenceFrame& Frame() {
+  static const SequenceFrame frame = [] {
+    static const HandModel hand = HandModel::Load(Handedness::kRight);
+    SequenceOptions options;
+    options.background = BackgroundKind::kClutter;
+    options.seed = 3;
+    Sequence sequence(hand, options);
+    return sequence.Render(options.frames / 2);
+  }();
+  return frame;
+}
+
+SkinOptions NoFaces() {
+  SkinOptions options;
+  options.face_cascade.clear();
+  return options;
+}
+
+void BM_SkinSegment(benchmark::State& state) {
+  SkinSegmenter segmenter(NoFaces());
+  for (auto _ : state) benchmark::DoNotOptimize(segmenter.Segment(Frame().rgb).regions.size());
+}
+BENCHMARK(BM_SkinSegment)->Unit(benchmark::kMicrosecond);
+
+void BM_FaceCascade(benchmark::State& state) {
+  SkinOptions options;
+  options.face_interval = 1;
+  SkinSegmenter segmenter(options);
+  for (auto _ : state) benchmark::DoNotOptimize(segmenter.Segment(Frame().rgb).faces.size());
+}
+BENCHMARK(BM_FaceCascade)->Unit(benchmark::kMicrosecond);
+
+void BM_ForearmCut(benchmark::State& state) {
+  SkinSegmenter segmenter(NoFaces());
+  const SkinSegmentation s = segmenter.Segment(Frame().rgb);
+  const cv::Mat region = s.RegionMask(s.regions.at(0));
+  for (auto _ : state) benchmark::DoNotOptimize(CutForearm(region, 0).cut);
+}
+BENCHMARK(BM_ForearmCut)->Unit(benchmark::kMicrosecond);
+
+void BM_Describe(benchmark::State& state) {
+  const cv::Mat hand = Frame().labels == static_cast<int>(PixelLabel::kHand);
+  const cv::Rect box = cv::boundingRect(hand);
+  const cv::Mat roi = hand(box);
+  const DescriptorConfig config;
+  for (auto _ : state) benchmark::DoNotOptimize(Describe(roi, config)->values.data());
+}
+BENCHMARK(BM_Describe)->Unit(benchmark::kMicrosecond);
+
+void BM_CombineWithPrior(benchmark::State& state) {
+  Random random(1);
+  std::vector<PoseX> poses(500);
+  std::vector<double> weights(500, 1.0 / 500);
+  for (PoseX& x : poses) {
+    for (int i = 0; i < x.size(); ++i) x[i] = random.Uniform(-1.0, 1.0);
+  }
+  std::vector<WeightedPose> carried;
+  for (int i = 0; i < state.range(0); ++i) carried.push_back({poses[i * 7], 1.0 / state.range(0)});
+  const EstimatorOptions options;
+  bool used = false;
+  for (auto _ : state) benchmark::DoNotOptimize(CombineWithPrior(poses, weights, carried, options, &used).data());
+}
+BENCHMARK(BM_CombineWithPrior)->Arg(5)->Arg(20)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace nphand
+
+BENCHMARK_MAIN();
