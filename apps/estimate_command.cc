@@ -109,7 +109,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
     if (!options.overlay.empty()) {
       const cv::Mat picture = Overlay(frame->bgr, result, &estimator, db);
       if (!video.isOpened()) {
-        video.open(video_partial.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), source.fps(), picture.size());
+        video.open(video_partial.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), source.fps(), picture.size());
         NPHAND_THROW_CHECK(video.isOpened(), video_partial.string(), ": cannot open a video writer (MPEG-4)");
       }
       video.write(picture);

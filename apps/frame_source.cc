@@ -37,7 +37,9 @@ FrameSource::FrameSource(const std::string& input, double fps) : input_(input), 
   if (digits && !std::filesystem::exists(path, error)) {
     kind_ = "camera";
     NPHAND_THROW_CHECK(input.size() < 4, "--input ", input, ": not a camera index (0..999)");
-    capture_.open(std::stoi(input), cv::CAP_ANY);
+    // Video4Linux only: probing every back end (FireWire, GStreamer) for a missing camera is
+    // slow and leaks in those libraries.
+    capture_.open(std::stoi(input), cv::CAP_V4L2);
     NPHAND_THROW_CHECK(capture_.isOpened(), "camera ", input, " is not there (or cannot be opened)");
     const double camera_fps = capture_.get(cv::CAP_PROP_FPS);
     if (camera_fps > 0.0) fps_ = camera_fps;
@@ -46,7 +48,9 @@ FrameSource::FrameSource(const std::string& input, double fps) : input_(input), 
   NPHAND_THROW_CHECK(std::filesystem::exists(path, error), input, ": no such file or folder");
   NPHAND_THROW_CHECK(std::filesystem::is_regular_file(path, error), input, ": not a video file or an image folder");
   kind_ = "video";
-  capture_.open(input, cv::CAP_ANY);
+  // FFmpeg reads every common container; GStreamer, the other back end Debian's OpenCV
+  // tries, fails on a file that is not a video with an assertion of its own.
+  capture_.open(input, cv::CAP_FFMPEG);
   NPHAND_THROW_CHECK(capture_.isOpened(), input, ": cannot read this as a video");
   const double video_fps = capture_.get(cv::CAP_PROP_FPS);
   if (video_fps > 0.0) fps_ = video_fps;

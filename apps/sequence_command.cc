@@ -31,7 +31,7 @@ nlohmann::json RunSequence(const SequenceCommandOptions& options, std::ostream* 
   cv::VideoWriter video;
   const std::filesystem::path video_partial = options.out_dir / "video.mp4.partial.mp4";
   if (options.video) {
-    video.open(video_partial.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), sequence_options.fps,
+    video.open(video_partial.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), sequence_options.fps,
                cv::Size(sequence_options.width, sequence_options.height));
     NPHAND_THROW_CHECK(video.isOpened(), video_partial.string(), ": cannot open a video writer (MPEG-4)");
     description["files"]["video"] = "video.mp4";

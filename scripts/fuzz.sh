@@ -7,7 +7,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds=60
-targets=(db_file db_content db_resume glb index index_body)
+targets=(db_file db_content db_resume glb index index_body poses)
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
@@ -80,6 +80,13 @@ PY
   selector=$((selector + 1))
 done
 export NPHAND_FUZZ_DB="$seeds/tiny.db"  # the database the index target loads its inputs against
+# poses: a short rendered sequence's truth, and the poses estimated on it as the seed.
+mkdir -p "$seeds/poses"
+"$build/apps/nphand" sequence --frames 3 --width 96 --height 72 --distance 0.3 --grasp 1 --out "$seeds/sequence" >/dev/null 2>&1
+"$build/apps/nphand" estimate --db "$seeds/tiny.db" --index "$seeds/index/tiny.idx" --input "$seeds/sequence/frames" \
+  --k 20 --max-distance 2 --top --no-faces --out "$seeds/poses/estimated.jsonl" >/dev/null 2>&1
+cp "$seeds/sequence/truth.jsonl" "$seeds/poses/truth.jsonl"
+export NPHAND_FUZZ_TRUTH="$seeds/sequence/truth.jsonl"
 
 failed=0
 for t in "${targets[@]}"; do

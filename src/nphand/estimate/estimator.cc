@@ -276,6 +276,8 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
     FrameResult attempt = Estimate(query, query_box, bgr.size(), result);
     attempt.forearm_cut = cut;
     if (attempt.detected() || c + 1 == std::min<size_t>(2, candidates.size())) {
+      // The hand is lost: the next frame starts from its observation alone.
+      if (!attempt.detected()) carried_.clear();
       if (left && attempt.detected()) MirrorResult(bgr.cols, &attempt);
       if (attempt.detected()) {
         last_centre_ = cv::Point2d(attempt.box.x + 0.5 * attempt.box.width, attempt.box.y + 0.5 * attempt.box.height);
@@ -313,6 +315,7 @@ FrameResult Estimator::ProcessMask(const cv::Mat& mask, double time_s) {
     query_box.x = mask.cols - box.x - box.width;
   }
   FrameResult out = Estimate(query, query_box, mask.size(), result);
+  if (!out.detected()) carried_.clear();
   if (left && out.detected()) MirrorResult(mask.cols, &out);
   out.ms.total = Ms(start, Clock::now());
   return out;
@@ -388,7 +391,6 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
     result.reason = "nothing in the database looks like this region (nearest feature distance " +
                     std::to_string(nearest) + " > " + std::to_string(options_.max_distance) + ")";
     result.box = box;
-    carried_.clear();
     result.ms.weigh = Ms(t, Clock::now());
     return result;
   }

@@ -160,7 +160,8 @@ class Estimator {
  private:
   // Everything after the hand's mask: describe, search, weigh, place. `hand_mask` is
   // frame-sized, `box` its pixels' bounds; `result` comes with frame, time and segmentation
-  // time filled in.
+  // time filled in. A region unlike any view leaves the carried hypotheses as they were
+  // (the caller may try another region, and forgets them if none is a hand).
   FrameResult Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result);
   const Grasp& GraspOf(int id);
   Scene EntryScene(uint32_t entry);
