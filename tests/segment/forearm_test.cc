@@ -81,6 +81,30 @@ TEST(ForearmTest, CutArmsGiveTheCropOfTheHandAlone) {
   EXPECT_LE(cut_without, frames / 5);
 }
 
+TEST(ForearmTest, AnArmLeavingTheFrameObliquelyIsCut) {
+  // A rendered frame whose arm enters from the bottom edge at a slant: the slices across the
+  // arm's cut end rise unevenly from nothing, and once passed for the arm's own width.
+  SequenceOptions options;
+  options.frames = 60;
+  options.seed = 21;
+  Sequence sequence(testing::RightHand(), options);
+  const SequenceFrame frame = sequence.Render(54);
+  SkinOptions skin;
+  skin.face_cascade.clear();
+  SkinSegmenter segmenter(skin);
+  const SkinSegmentation s = segmenter.Segment(frame.rgb);
+  ASSERT_FALSE(s.regions.empty());
+  const SkinRegion& region = s.regions[0];
+  const ForearmCut c = CutForearm(s.RegionMask(region), Border(region.box, frame.rgb.size()));
+  ASSERT_TRUE(c.cut);
+  // What is left is the hand: most of its pixels, little of the arm's.
+  const cv::Mat labels = frame.labels(region.box);
+  EXPECT_GT(cv::countNonZero(c.hand & (labels == static_cast<int>(PixelLabel::kHand))),
+            0.9 * cv::countNonZero(labels == static_cast<int>(PixelLabel::kHand)));
+  EXPECT_LT(cv::countNonZero(c.hand & (labels == static_cast<int>(PixelLabel::kForearm))),
+            0.1 * cv::countNonZero(labels == static_cast<int>(PixelLabel::kForearm)));
+}
+
 TEST(ForearmTest, ARegionWithoutAnArmIsLeftWhole) {
   cv::Mat disc = cv::Mat::zeros(200, 200, CV_8UC1);
   cv::circle(disc, cv::Point(100, 100), 60, cv::Scalar(255), cv::FILLED);

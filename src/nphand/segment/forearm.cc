@@ -98,10 +98,21 @@ Reading Read(const std::vector<cv::Point>& points, cv::Point2d centre, cv::Point
   // (steps from that end), or -1.
   auto find_wrist = [&](int direction, double* wrist_width) {
     auto index = [&](int step) { return direction > 0 ? step : slices - 1 - step; };
-    // Skip the end's cap, where the width still grows (a rounded end, or an arm that leaves
-    // the frame obliquely).
+    // Skip the end's cap, where the width still grows: a rounded end, or an arm that leaves
+    // the frame obliquely, whose cut edge can rise unevenly, so there the cap lasts until
+    // the width is near that of the stretch beyond it.
+    const bool at_edge = (direction > 0 ? touch_low : touch_high) > 0;
     int first = 0;
     while (first + 1 < slices && width[index(first + 1)] > 1.02 * width[index(first)]) ++first;
+    if (at_edge) {
+      const int ahead = std::max(3, slices / 20);
+      for (; first + ahead < slices; ++first) {
+        std::vector<double> next;
+        for (int j = first + 1; j <= first + ahead; ++j) next.push_back(width[index(j)]);
+        std::nth_element(next.begin(), next.begin() + next.size() / 2, next.end());
+        if (width[index(first)] >= 0.9 * next[next.size() / 2]) break;
+      }
+    }
     double narrowest = 1e300;
     int at = -1;
     for (int step = first; step < slices; ++step) {
@@ -116,8 +127,7 @@ Reading Read(const std::vector<cv::Point>& points, cv::Point2d centre, cv::Point
       if (step > first && width[k] > options.widen_ratio * narrowest) {
         *wrist_width = narrowest;
         // An arm: long enough before the cut and not as thin as a finger.
-        const bool edge = (direction > 0 ? touch_low : touch_high) > 0;
-        const double length = edge ? options.min_arm_length_at_edge : options.min_arm_length;
+        const double length = at_edge ? options.min_arm_length_at_edge : options.min_arm_length;
         if (at >= length * narrowest && narrowest >= options.min_arm_width * widest) return at;
         return -1;
       }
