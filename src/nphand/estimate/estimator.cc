@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <array>
+#include <chrono>
 #include <numbers>
 
 #include <opencv2/imgproc.hpp>
@@ -156,9 +157,7 @@ bool EstimatorOptions::Check(std::string* why) const {
 
 double ModelHandLength(const Database& db) {
   for (size_t i = 0; i < db.size(); ++i) {
-    if (!db.Meta(i).has_hand) continue;
-    const Keypoints3d k = db.Keypoints(i);
-    return (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
+    if (db.Meta(i).has_hand) return HandLength(db.Keypoints(i));
   }
   NPHAND_THROW("the database holds no entry with a hand");
 }
@@ -333,16 +332,6 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   std::vector<Descriptor> descriptors;
   for (const HandCrop& c : crops) descriptors.push_back(DescribeCrop(c, config));
   result.both_turns = crops.size() == 2;
-  {
-    std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(hand_mask(roi).clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
-    std::vector<cv::Point> all;
-    for (const auto& c : contours) all.insert(all.end(), c.begin(), c.end());
-    std::vector<cv::Point> hull;
-    if (all.size() >= 3) cv::convexHull(all, hull);
-    const double hull_area = hull.size() >= 3 ? cv::contourArea(hull) : 0.0;
-    result.solidity = hull_area > 0.0 ? std::min(1.0, cv::countNonZero(hand_mask(roi)) / hull_area) : 1.0;
-  }
   result.ms.describe = Ms(t, Clock::now());
 
   t = Clock::now();
@@ -353,10 +342,10 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   t = Clock::now();
   struct Candidate {
     uint32_t entry;
+    EntryMeta meta;
     int turn_of;  // which crop
     double distance;
     double turn;
-    Eigen::Matrix3d rotation;
     PoseX x;
     double w = 0.0;
   };
@@ -367,16 +356,16 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
       h.entry = found[c].ids[i];
       h.turn_of = static_cast<int>(c);
       h.distance = std::sqrt(std::max(0.0f, found[c].distances[i]));
-      const EntryMeta meta = db_.Meta(h.entry);
-      h.turn = config.normalize_roll ? std::remainder(crops[c].roll - meta.roll, 2.0 * std::numbers::pi) : 0.0;
+      h.meta = db_.Meta(h.entry);
+      h.turn = config.normalize_roll ? std::remainder(crops[c].roll - h.meta.roll, 2.0 * std::numbers::pi) : 0.0;
       const PoseVector pose = db_.Pose(h.entry);
       Eigen::Matrix3d entry_rotation;
       for (int r = 0; r < 3; ++r) {
         for (int col = 0; col < 3; ++col) entry_rotation(r, col) = pose[3 * r + col];
       }
-      h.rotation = AxisAngle(Eigen::Vector3d::UnitZ(), h.turn) * entry_rotation;
+      const Eigen::Matrix3d rotation = AxisAngle(Eigen::Vector3d::UnitZ(), h.turn) * entry_rotation;
       for (int r = 0; r < 3; ++r) {
-        for (int col = 0; col < 3; ++col) h.x[3 * r + col] = h.rotation(r, col);
+        for (int col = 0; col < 3; ++col) h.x[3 * r + col] = rotation(r, col);
       }
       h.x.tail<kNumDofs>() = pose.tail<kNumDofs>();
       hyp.push_back(std::move(h));
@@ -436,18 +425,24 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   for (WeightedPose& c : carried_) c.weight = carried_sum > 0.0 ? c.weight / carried_sum : 1.0 / carried_.size();
 
   // Posteriors, confidence.
-  std::map<std::string, double> grasps, objects;
+  // Summed by grasp number and by object shape (the last slot: no object); named once.
+  std::array<double, kNumGrasps + 1> grasp_mass{};
+  std::array<double, static_cast<int>(ObjectShape::kStick) + 2> object_mass{};
+  constexpr size_t kNoObject = static_cast<int>(ObjectShape::kStick) + 1;
   double squares = 0.0, mode = 0.0;
   for (const Candidate& h : hyp) {
-    const EntryMeta meta = db_.Meta(h.entry);
-    const GraspDefinition& g = GraspTaxonomy()[meta.grasp - 1];
-    grasps[GraspKey(g)] += h.w;
-    objects[meta.with_object ? ToString(g.object.shape) : std::string("none")] += h.w;
+    grasp_mass[h.meta.grasp] += h.w;
+    object_mass[h.meta.with_object ? static_cast<size_t>(GraspTaxonomy()[h.meta.grasp - 1].object.shape) : kNoObject] += h.w;
     squares += h.w * h.w;
     if ((h.x - best.x).norm() < options_.sigma_x) mode += h.w;
   }
-  result.grasps.assign(grasps.begin(), grasps.end());
-  result.objects.assign(objects.begin(), objects.end());
+  for (int g = 1; g <= kNumGrasps; ++g) {
+    if (grasp_mass[g] > 0.0) result.grasps.emplace_back(GraspKey(GraspTaxonomy()[g - 1]), grasp_mass[g]);
+  }
+  for (size_t o = 0; o < object_mass.size(); ++o) {
+    if (object_mass[o] <= 0.0) continue;
+    result.objects.emplace_back(o == kNoObject ? std::string("none") : ToString(static_cast<ObjectShape>(o)), object_mass[o]);
+  }
   auto by_weight = [](const auto& a, const auto& b) { return a.second != b.second ? a.second > b.second : a.first < b.first; };
   std::sort(result.grasps.begin(), result.grasps.end(), by_weight);
   std::sort(result.objects.begin(), result.objects.end(), by_weight);
@@ -463,7 +458,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
     out.turn = h.turn;
     out.pose.angles = db_.Angles(h.entry);
     out.pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), h.turn) *
-                                CameraFromHand(ViewpointFromDirection(directions_[db_.Meta(h.entry).viewpoint]));
+                                CameraFromHand(ViewpointFromDirection(directions_[h.meta.viewpoint]));
     result.top.push_back(out);
   }
   result.pose = result.top[0].pose;

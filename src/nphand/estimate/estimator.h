@@ -9,7 +9,6 @@
 #pragma once
 
 #include <array>
-#include <chrono>
 #include <optional>
 #include <string>
 #include <vector>
@@ -111,7 +110,6 @@ struct FrameResult {
   std::vector<std::pair<std::string, double>> grasps;   // posterior over grasp names, descending
   std::vector<std::pair<std::string, double>> objects;  // posterior over object shapes ("none": no object)
   double nearest_distance = 0.0;               // the best neighbour's feature distance
-  double solidity = 0.0;                       // the hand's area over its convex hull's
   double effective_samples = 0.0;              // 1 / sum w^2 over the hypotheses
   double confidence = 0.0;                     // the posterior mass near the estimate, 0..1
   StageMilliseconds ms;

@@ -40,10 +40,7 @@ nlohmann::json FrameResultJson(const FrameResult& r, const Database& db, bool wi
              {"weigh", r.ms.weigh},     {"place", r.ms.place},       {"total", r.ms.total}};
   if (!r.detected()) {
     j["reason"] = r.reason;
-    if (r.status == FrameStatus::kNotAHand) {
-      j["nearest_distance"] = r.nearest_distance;
-      j["solidity"] = r.solidity;
-    }
+    if (r.status == FrameStatus::kNotAHand) j["nearest_distance"] = r.nearest_distance;
     return j;
   }
   const Eigen::Quaterniond q(r.pose.camera_from_hand);
@@ -65,7 +62,6 @@ nlohmann::json FrameResultJson(const FrameResult& r, const Database& db, bool wi
   j["confidence"] = r.confidence;
   j["effective_samples"] = r.effective_samples;
   j["nearest_distance"] = r.nearest_distance;
-  j["solidity"] = r.solidity;
   j["forearm_cut"] = r.forearm_cut;
   j["both_turns"] = r.both_turns;
   j["prior_used"] = r.prior_used;

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <opencv2/imgproc.hpp>
 
+#include "nphand/model/hand_model.h"
 #include "nphand/model/hand_pose.h"
 #include "nphand/model/skeleton.h"
 #include "nphand/util/check.h"
@@ -52,9 +53,10 @@ T Field(const nlohmann::json& line, const char* key, const std::filesystem::path
 using Points3 = std::vector<std::array<double, 3>>;
 using Points2 = std::vector<std::array<double, 2>>;
 
-double ChainLength(const Points3& k) {
-  auto d = [&](int a, int b) { return std::hypot(k[a][0] - k[b][0], k[a][1] - k[b][1], k[a][2] - k[b][2]); };
-  return d(0, 9) + d(9, 10) + d(10, 11) + d(11, 12);
+double ChainLength(const Points3& points) {
+  Keypoints3d k;
+  for (int i = 0; i < kNumKeypoints; ++i) k[i] = Eigen::Vector3d(points[i][0], points[i][1], points[i][2]);
+  return HandLength(k);
 }
 
 double Mean(const std::vector<double>& v) {

@@ -75,6 +75,10 @@ const char* PinnedAssetSha256(Handedness handedness) {
 
 std::string AssetFileName(Handedness handedness) { return ToString(handedness) + ".glb"; }
 
+double HandLength(const Keypoints3d& k) {
+  return (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
+}
+
 HandModel HandModel::Load(Handedness handedness, const std::filesystem::path& asset_dir) {
   const std::filesystem::path path = asset_dir / AssetFileName(handedness);
   NPHAND_THROW_CHECK(std::filesystem::exists(path), path.string(),

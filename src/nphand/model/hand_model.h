@@ -31,6 +31,10 @@ const char* PinnedAssetSha256(Handedness handedness);
 std::string AssetFileName(Handedness handedness);
 
 using Keypoints3d = std::array<Eigen::Vector3d, kNumKeypoints>;
+
+// A hand's length from the wrist to the middle fingertip along its bones (keypoints 0, 9,
+// 10, 11, 12): the same in every pose, so it gives a hand's size from any of its poses.
+double HandLength(const Keypoints3d& keypoints);
 using JointPositions = std::array<Eigen::Vector3d, kNumJoints>;
 
 class HandModel {

@@ -141,8 +141,7 @@ Sequence::Sequence(const HandModel& hand, const SequenceOptions& options)
 }
 
 double Sequence::hand_length_m() const {
-  const Keypoints3d k = hand_.KeypointsOf(HandPose{});
-  return (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
+  return HandLength(hand_.KeypointsOf(HandPose{}));
 }
 
 JointAngles Sequence::AnglesAt(double step) const {
