@@ -20,6 +20,13 @@
 
 namespace {
 
+// "a, b, c": for the lists of names in help texts.
+std::string CommaList(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& name : names) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
 void AddGraspCheck(CLI::Option* option) {
   option->check(CLI::Validator(
       [](std::string& item) { return item.empty() ? std::string("an empty item (expected e.g. 1,13)") : std::string(); },
@@ -221,7 +228,7 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
 
 // The backend and its options (`--<backend>-<option>`); `seed` is every backend's seed.
 void AddIndexOptions(CLI::App* cmd, nphand::IndexOptions& o, uint64_t& seed) {
-  cmd->add_option("--backend", o.backend, "exact, lsh, faiss-hnsw, faiss-ivf, hnswlib or flann")->capture_default_str();
+  cmd->add_option("--backend", o.backend, "One of: " + CommaList(nphand::IndexBackends()))->capture_default_str();
   nphand::LshOptions& lsh = o.lsh;
   cmd->add_option("--lsh-tables", lsh.tables, "LSH: hash tables (L)")->capture_default_str();
   cmd->add_option("--lsh-probes", lsh.probes, "LSH: buckets probed per table (T)")->capture_default_str();
@@ -231,7 +238,7 @@ void AddIndexOptions(CLI::App* cmd, nphand::IndexOptions& o, uint64_t& seed) {
       ->capture_default_str();
   cmd->add_option("--lsh-k", lsh.tune_k, "LSH: the K whose recall is tuned")->capture_default_str();
   cmd->add_option("--lsh-queries", lsh.tune_queries, "LSH: sampled queries the tuner measures on")->capture_default_str();
-  cmd->add_option("--hnsw-m", o.hnsw.m, "HNSW (faiss-hnsw, hnswlib): links per node")->capture_default_str();
+  cmd->add_option("--hnsw-m", o.hnsw.m, "HNSW (faiss-hnsw, hnswlib, hnswlib-sq8): links per node")->capture_default_str();
   cmd->add_option("--hnsw-ef-construction", o.hnsw.ef_construction, "HNSW: candidates while inserting")
       ->capture_default_str();
   cmd->add_option("--hnsw-ef", o.hnsw.ef_search, "HNSW: candidates while searching (at least K)")->capture_default_str();
@@ -284,9 +291,9 @@ void AddEvalAnnCommand(CLI::App* eval, nphand::EvalAnnCommandOptions& o, bool& j
   ann->add_option("--queries", s.queries, "Held-out rendered queries")->capture_default_str();
   ann->add_option("--k", s.k, "Neighbours per query (K)")->capture_default_str();
   ann->add_option("--fractions", s.fractions, "Database fractions, in (0, 1]")->delimiter(',')->capture_default_str();
-  ann->add_option("--backends", s.configs,
-                  "Backend settings (default all: exact, lsh, faiss-hnsw, hnswlib, hnswlib-pca64, faiss-ivf, "
-                  "faiss-ivf-sq8, flann-kdtree, flann-kmeans)")->delimiter(',');
+  std::vector<std::string> settings;
+  for (const nphand::AnnConfig& c : nphand::StudyConfigs()) settings.push_back(c.name);
+  ann->add_option("--backends", s.configs, "Backend settings (default all: " + CommaList(settings) + ")")->delimiter(',');
   ann->add_option("--seed", s.seed, "Seed of the queries and the fractions' samples")->capture_default_str();
   ann->add_option("--out", o.out_dir, "Folder for the JSON and the plot");
   ann->add_option("--name", o.name, "File name of the JSON and the plot")->capture_default_str();

@@ -15,9 +15,9 @@ TEST(IndexCommandTest, BuildsAnIndexBesideTheDatabaseAndDescribesIt) {
   options.db = testing::BuildTinyDatabase(dir / "tiny.db");
   const nlohmann::json built = RunIndexBuild(options);
   EXPECT_EQ(built["path"], (dir / "tiny.db.idx").string());
-  EXPECT_EQ(built["backend"], "hnswlib") << "the default the nearest-neighbour study chose";
+  EXPECT_EQ(built["backend"], "hnswlib-sq8") << "the default the nearest-neighbour study chose";
   const nlohmann::json info = RunIndexInfo(dir / "tiny.db.idx");
-  EXPECT_EQ(info["backend"], "hnswlib");
+  EXPECT_EQ(info["backend"], "hnswlib-sq8");
   EXPECT_EQ(info["parameters"]["ef_search"], 500);
   EXPECT_EQ(info["database"]["checksum"], Database::Open(options.db).checksum());
   EXPECT_EQ(info["entries"], built["entries"]);

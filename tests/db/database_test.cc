@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <limits>
 
@@ -222,6 +223,48 @@ TEST(DatabaseTest, WriterRefusesAWrongRecordCount) {
   const std::vector<uint8_t> three(3 * layout.RecordBytes(), 0);
   EXPECT_THROW(writer.Append(three), Error);
   EXPECT_THROW(writer.Finish(), Error);
+}
+
+// Kilobytes of the mapping holding `address` that are resident in this process
+// (/proc/self/smaps), or -1 when no mapping holds it.
+long ResidentKb(const void* address) {
+  std::ifstream smaps("/proc/self/smaps");
+  const auto at = reinterpret_cast<uintptr_t>(address);
+  std::string line;
+  bool inside = false;
+  while (std::getline(smaps, line)) {
+    uintptr_t begin = 0, end = 0;
+    if (std::sscanf(line.c_str(), "%lx-%lx ", &begin, &end) == 2 && line.find(' ') > line.find('-')) {
+      inside = at >= begin && at < end;
+    } else if (inside && line.rfind("Rss:", 0) == 0) {
+      return std::stol(line.substr(4));
+    }
+  }
+  return -1;
+}
+
+TEST(DatabaseTest, PassesOverTheRecordsLeaveNoneResident) {
+  const Database db = Database::Open(testing::BuildTinyDatabase(testing::ScratchDir() / "tiny.db"));
+  const std::span<const uint8_t> records = db.Records(0, db.size());
+  const long file_kb = static_cast<long>(records.size() / 1024);
+  EXPECT_LT(ResidentKb(records.data()), file_kb / 4) << "Open's verification released what it read";
+  const std::vector<uint8_t> copy(records.begin(), records.end());
+  db.ReleasePages(0, db.size());
+  std::vector<size_t> visited;
+  double sum = 0.0;
+  ScanRecords(db, [&](size_t i) {
+    visited.push_back(i);
+    sum += db.Hog(i)[0];
+  });
+  ASSERT_EQ(visited.size(), db.size());
+  for (size_t i = 0; i < visited.size(); ++i) EXPECT_EQ(visited[i], i);
+  EXPECT_LT(ResidentKb(records.data()), file_kb / 4) << "a scan releases what it read";
+  for (size_t i = 0; i < db.size(); ++i) sum += db.Hog(i)[0];
+  EXPECT_GT(ResidentKb(records.data()), file_kb / 2) << "plain reads stay resident (the check can see them)";
+  db.ReleasePages(0, db.size());
+  EXPECT_LT(ResidentKb(records.data()), file_kb / 4);
+  EXPECT_TRUE(std::equal(copy.begin(), copy.end(), db.Records(0, db.size()).begin())) << "released pages read back";
+  EXPECT_GE(sum, 0.0);
 }
 
 TEST(DatabaseTest, TinyBuiltDatabaseOpensAndHoldsHandCrops) {

@@ -4,6 +4,9 @@
 #include "nphand/index/backends.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -26,6 +29,8 @@ struct BackendCase {
   // Whether a loaded index answers as the built one did: Debian's FLANN seeds its shuffles
   // from std::random_device, so its trees, rebuilt at load, differ from build to build.
   bool reproducible = true;
+  // Whether it searches 8-bit codes of the rows: its distances are the codes'.
+  bool quantized = false;
 };
 
 void PrintTo(const BackendCase& c, std::ostream* out) { *out << c.name; }
@@ -52,6 +57,9 @@ std::vector<BackendCase> Cases() {
     add(hnsw, [](IndexOptions& o) { o.hnsw.ef_search = 1000; },
         [](IndexOptions& o) { o.hnsw.m = 4, o.hnsw.ef_construction = 16, o.hnsw.ef_search = 10; }, 0.7);
   }
+  add("hnswlib-sq8", [](IndexOptions& o) { o.hnsw.ef_search = 1000; },
+      [](IndexOptions& o) { o.hnsw.m = 4, o.hnsw.ef_construction = 16, o.hnsw.ef_search = 10; }, 0.7);
+  cases.back().quantized = true;
   add("hnswlib/pca", [](IndexOptions& o) { o.hnsw.pca = 16, o.hnsw.ef_search = 1000; },
       [](IndexOptions& o) { o.hnsw.pca = 16, o.hnsw.m = 4, o.hnsw.ef_construction = 16, o.hnsw.ef_search = 20; }, 0.6);
   for (const char* encoding : {"flat", "sq8"}) {
@@ -89,6 +97,20 @@ TEST_P(BackendTest, ExhaustiveSettingsGiveTheExactNeighbours) {
   for (size_t q : {size_t{0}, size_t{31}, size_t{77}, size_t{150}}) {
     for (int k : {1, 10, 40}) {
       const Neighbours want = exact->Search(QueryOf(q), k), got = index->Search(QueryOf(q), k);
+      if (GetParam().quantized) {
+        // Each distance is its entry's true one but for the codes' rounding; the entries
+        // are among the true k nearest (ties included) but where rounding swaps near-equal
+        // ones.
+        const Neighbours all = exact->Search(QueryOf(q), static_cast<int>(exact->size()));
+        size_t found = 0;
+        for (size_t r = 0; r < got.ids.size(); ++r) {
+          const auto at = std::find(all.ids.begin(), all.ids.end(), got.ids[r]) - all.ids.begin();
+          EXPECT_NEAR(got.distances[r], all.distances[at], 0.01) << q << " k=" << k;
+          found += all.distances[at] <= want.distances.back();
+        }
+        EXPECT_GE(static_cast<double>(found), 0.9 * k) << q << " k=" << k;
+        continue;
+      }
       ASSERT_EQ(got.distances, want.distances) << q << " k=" << k;
       // Entries at the k-th distance tie (a hand the object does not touch looks the same
       // with and without it); below it the entries must agree.
@@ -182,7 +204,7 @@ class ForgedBodyTest : public testing::TinyDatabaseTest {
 };
 
 TEST_F(ForgedBodyTest, GraphsWithLinksOutsideTheirLevelAreRefused) {
-  for (const std::string backend : {"faiss-hnsw", "hnswlib"}) {
+  for (const std::string backend : {"faiss-hnsw", "hnswlib", "hnswlib-sq8"}) {
     const std::vector<uint8_t> body = RealBody(backend);
     // The body ends with the link values; point the last one at a node that does not exist.
     std::vector<uint8_t> bad = body;
@@ -195,6 +217,42 @@ TEST_F(ForgedBodyTest, GraphsWithLinksOutsideTheirLevelAreRefused) {
     longer.push_back(0);
     testing::ExpectError([&] { LoadIndex(Forge(backend, longer), db()); }, "forged.idx: ");
     testing::ExpectError([&] { LoadIndex(Forge(backend, {}), db()); }, "forged.idx: the index body is truncated");
+  }
+}
+
+TEST_F(ForgedBodyTest, CodeStepsThatAreNotPositiveAreRefused) {
+  const std::vector<uint8_t> body = RealBody("hnswlib-sq8");
+  for (float step : {0.0f, -1.0f, std::numeric_limits<float>::quiet_NaN()}) {
+    std::vector<uint8_t> bad = body;
+    std::memcpy(bad.data(), &step, 4);
+    testing::ExpectError([&] { LoadIndex(Forge("hnswlib-sq8", bad), db()); }, "forged.idx: the 8-bit code step");
+  }
+}
+
+// Rows whose values are whole steps are coded without loss: the codes' search is the
+// exact search.
+TEST_F(ForgedBodyTest, RowsOfWholeStepsAreSearchedExactly) {
+  IndexedSet set = DatabaseDescriptors(db());
+  std::vector<float> values = set.descriptors.values();
+  const float step = *std::max_element(values.begin(), values.end()) / 255.0f;
+  for (float& v : values) v = std::round(v / step) * step;
+  const DescriptorConfig config = set.descriptors.config();
+  const IndexedSet whole{DescriptorMatrix(config, values), set.ids};
+  const std::unique_ptr<KnnIndex> exact = BuildIndex(whole, IndexOptions::Exact());
+  IndexOptions options;
+  options.backend = "hnswlib-sq8";
+  options.hnsw.ef_search = 1000;
+  const std::unique_ptr<KnnIndex> coded = BuildIndex(whole, options);
+  for (size_t r = 0; r < whole.ids.size(); r += 17) {
+    const Descriptor query{config, std::vector<float>(whole.descriptors.Row(r).begin(), whole.descriptors.Row(r).end()), 0.0};
+    const Neighbours want = exact->Search(query, 20), got = coded->Search(query, 20);
+    ASSERT_EQ(got.ids.size(), want.ids.size());
+    for (size_t i = 0; i < want.ids.size(); ++i) {
+      EXPECT_NEAR(got.distances[i], want.distances[i], 1e-5f * (1.0f + want.distances[i])) << r << " rank " << i;
+      if (want.distances[i] < want.distances.back() - 1e-5f) {
+        EXPECT_EQ(got.ids[i], want.ids[i]) << r << " rank " << i;
+      }
+    }
   }
 }
 

@@ -9,6 +9,7 @@
 #include <set>
 
 #include <sys/mman.h>
+#include <unistd.h>
 #include <zlib.h>  // crc32_combine
 
 #include "nphand/features/hog.h"
@@ -452,20 +453,33 @@ Database Database::Open(const std::filesystem::path& path, bool verify_records) 
     uint32_t crc = 0;
     const Enumeration enumeration(db.header_);
     std::optional<Error> impossible;
+    size_t previous = 0;  // the block before, released again as ScanRecords does
     for (size_t begin = 0; begin < count; begin += kBlock) {
       const size_t end = std::min<size_t>(count, begin + kBlock);
       crc = Crc32(crc, {db.records_ + begin * record_bytes, (end - begin) * record_bytes});
-      if (impossible) continue;
-      try {
-        db.VerifyRecords(enumeration, begin, end);
-      } catch (const Error& e) {
-        impossible = e;
+      if (!impossible) {
+        try {
+          db.VerifyRecords(enumeration, begin, end);
+        } catch (const Error& e) {
+          impossible = e;
+        }
       }
+      db.ReleasePages(previous, end);
+      previous = begin;
     }
     NPHAND_THROW_CHECK(crc == Get<uint32_t>(footer + 16), source, ": checksum mismatch in the records");
     if (impossible) throw *impossible;
   }
   return db;
+}
+
+void Database::ReleasePages(size_t begin, size_t end) const {
+  NPHAND_CHECK(begin <= end && end <= count_);
+  // Whole pages: from the one holding the first byte to the end of the one holding the last.
+  const uintptr_t page = static_cast<uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const uintptr_t first = reinterpret_cast<uintptr_t>(records_ + begin * layout_.RecordBytes()) / page * page;
+  const uintptr_t last = reinterpret_cast<uintptr_t>(records_ + end * layout_.RecordBytes());
+  if (last > first) ::madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
 }
 
 void Database::VerifyRecords(const Enumeration& enumeration, size_t begin, size_t end) const {

@@ -106,6 +106,7 @@ std::vector<AnnConfig> StudyConfigs() {
   add("faiss-hnsw", "faiss-hnsw");
   add("hnswlib", "hnswlib");
   add("hnswlib-pca64", "hnswlib").hnsw.pca = 64;
+  add("hnswlib-sq8", "hnswlib-sq8");
   add("faiss-ivf", "faiss-ivf");
   add("faiss-ivf-sq8", "faiss-ivf").ivf.encoding = "sq8";
   add("flann-kdtree", "flann");

@@ -14,16 +14,16 @@
 
 namespace nphand {
 
-// exact, lsh, faiss-hnsw, faiss-ivf, hnswlib, flann.
+// exact, lsh, faiss-hnsw, faiss-ivf, hnswlib, hnswlib-sq8, flann.
 const std::vector<std::string>& IndexBackends();
 
 struct IndexOptions {
-  // One of IndexBackends(). The default, hnswlib with HnswOptions' defaults, is the
+  // One of IndexBackends(). The default, hnswlib-sq8 with HnswOptions' defaults, is the
   // fastest setting of the nearest-neighbour study (docs/ann_study.md) that keeps recall@500
   // above 0.95 on held-out renders.
-  std::string backend = "hnswlib";
+  std::string backend = "hnswlib-sq8";
   LshOptions lsh;                 // for lsh
-  HnswOptions hnsw;               // for faiss-hnsw and hnswlib
+  HnswOptions hnsw;               // for faiss-hnsw, hnswlib and hnswlib-sq8
   IvfOptions ivf;                 // for faiss-ivf
   FlannOptions flann;             // for flann
 

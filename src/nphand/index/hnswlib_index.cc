@@ -6,12 +6,13 @@
 #include <cstring>
 #include <mutex>
 #include <numeric>
+#include <optional>
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 // hnswlib 0.6.2's SSE path prefetches one link past the end of a full upper-level list (a
-// heap over-read AddressSanitizer reports); its SIMD distances are not used here (the nodes
-// hold row pointers, see RowPointerSpace), so it is switched off.
+// heap over-read AddressSanitizer reports); its SIMD distances are not used here (nphand's
+// own spaces: RowPointerSpace, CodeSpace), so it is switched off.
 #define NO_MANUAL_VECTORIZATION
 #include <hnswlib/hnswlib.h>
 
@@ -47,6 +48,56 @@ class RowPointerSpace : public hnswlib::SpaceInterface<float> {
   size_t dimension_;
 };
 
+// The squared distance of two rows of 8-bit codes, exact in integers (at most 65,025 per
+// value). Compiled for AVX2 too and chosen by the CPU at load time; the sum is the same.
+__attribute__((target_clones("avx2", "default"))) uint32_t CodeDistance(const uint8_t* a, const uint8_t* b,
+                                                                         size_t dimension) {
+  uint32_t sum = 0;
+  for (size_t i = 0; i < dimension; ++i) {
+    const int d = static_cast<int>(a[i]) - static_cast<int>(b[i]);
+    sum += static_cast<uint32_t>(d * d);
+  }
+  return sum;
+}
+
+// hnswlib's space over 8-bit codes held in the nodes: code = value / step, rounded,
+// clamped to 0..255; the distance is the codes' squared distance times step^2.
+class CodeSpace : public hnswlib::SpaceInterface<float> {
+ public:
+  CodeSpace(size_t dimension, float step) : parameter_{dimension, step * step} {}
+  size_t get_data_size() override { return parameter_.dimension; }
+  hnswlib::DISTFUNC<float> get_dist_func() override { return &Distance; }
+  void* get_dist_func_param() override { return &parameter_; }
+
+ private:
+  struct Parameter {
+    size_t dimension;
+    float step_squared;
+  };
+  static float Distance(const void* a, const void* b, const void* parameter) {
+    const auto* p = static_cast<const Parameter*>(parameter);
+    return static_cast<float>(CodeDistance(static_cast<const uint8_t*>(a), static_cast<const uint8_t*>(b),
+                                           p->dimension)) *
+           p->step_squared;
+  }
+  Parameter parameter_;
+};
+
+// The step that maps the largest value of the rows to 255 (1 when every value is 0).
+float CodeStep(float largest) { return largest > 0.0f ? largest / 255.0f : 1.0f; }
+
+void Encode(std::span<const float> row, float step, uint8_t* codes) {
+  for (size_t c = 0; c < row.size(); ++c) {
+    codes[c] = static_cast<uint8_t>(std::clamp(row[c] / step, 0.0f, 255.0f) + 0.5f);  // rounded half up
+  }
+}
+
+// The rows' codes, with their step (hnswlib-sq8).
+struct Sq8Codes {
+  float step = 1.0f;
+  std::vector<uint8_t> codes;  // rows x dimension
+};
+
 using RowMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 // Rows sampled to fit the PCA projection.
@@ -57,25 +108,37 @@ constexpr int kMaxLevel = 64;
 
 class HnswlibIndex : public KnnIndex {
  public:
+  // "hnswlib": the nodes point to the set's rows, or to their projections.
   HnswlibIndex(IndexedSet set, const HnswOptions& options)
       : KnnIndex(std::move(set)), options_(options),
-        space_(static_cast<size_t>(options.pca > 0 ? options.pca : config().Dimension())),
-        graph_(std::make_unique<Graph>(&space_, std::max<size_t>(size(), 1), options.m, options.ef_construction,
-                                       options.seed)) {
+        space_(std::make_unique<RowPointerSpace>(
+            static_cast<size_t>(options.pca > 0 ? options.pca : config().Dimension()))) {
     NPHAND_THROW_CHECK(options.pca <= config().Dimension(), "hnswlib: a PCA to ", options.pca,
                        " dimensions of a ", config().Dimension(), "-dimensional descriptor");
-    graph_->setEf(options.ef_search);
+    MakeGraph();
+  }
+  // "hnswlib-sq8": the nodes hold the rows' codes; `ids` has no descriptor rows.
+  HnswlibIndex(IndexedSet ids, Sq8Codes codes, const HnswOptions& options)
+      : KnnIndex(std::move(ids)), options_(options), sq8_(std::move(codes)),
+        space_(std::make_unique<CodeSpace>(static_cast<size_t>(config().Dimension()), sq8_->step)) {
+    NPHAND_CHECK(options.pca == 0 && sq8_->codes.size() == size() * config().Dimension());
+    MakeGraph();
   }
 
   void Build(std::ostream* progress) {
     if (options_.pca > 0) FitPca();
-    ProgressLine line(progress, "index build: hnswlib", size(), "entries");
+    ProgressLine line(progress, "index build: " + Backend(), size(), "entries");
     for (size_t i = 0; i < size(); ++i) {
-      const float* row = GraphRow(i);
-      graph_->addPoint(&row, i);
+      if (sq8_) {
+        graph_->addPoint(Codes(i), i);
+      } else {
+        const float* row = GraphRow(i);
+        graph_->addPoint(&row, i);
+      }
       line.Update(i + 1);
     }
     line.Finish();
+    ReleaseCodes();
   }
 
   // The graph of a body, checked: levels, link counts within hnswlib's limits, links to
@@ -139,8 +202,12 @@ class HnswlibIndex : public KnnIndex {
         g.linkLists_[i] = static_cast<char*>(std::calloc(bytes, 1));
         NPHAND_THROW_CHECK(g.linkLists_[i] != nullptr, body.source(), ": out of memory for the HNSW graph");
       }
-      const float* row = GraphRow(i);
-      std::memcpy(g.getDataByInternalId(static_cast<hnswlib::tableint>(i)), &row, sizeof(row));
+      if (sq8_) {
+        std::memcpy(g.getDataByInternalId(static_cast<hnswlib::tableint>(i)), Codes(i), config().Dimension());
+      } else {
+        const float* row = GraphRow(i);
+        std::memcpy(g.getDataByInternalId(static_cast<hnswlib::tableint>(i)), &row, sizeof(row));
+      }
       g.setExternalLabel(static_cast<hnswlib::tableint>(i), i);
       read_list(g.get_linklist0(static_cast<hnswlib::tableint>(i)), 0, g.maxM0_);
       for (int level = 1; level <= levels[i]; ++level) {
@@ -150,9 +217,10 @@ class HnswlibIndex : public KnnIndex {
     NPHAND_THROW_CHECK(at == links.size(), body.source(), ": ", links.size() - at, " link values after the last list");
     g.enterpoint_node_ = n == 0 ? static_cast<hnswlib::tableint>(-1) : entry;
     g.maxlevel_ = top;
+    ReleaseCodes();
   }
 
-  std::string Backend() const override { return "hnswlib"; }
+  std::string Backend() const override { return sq8_ ? "hnswlib-sq8" : "hnswlib"; }
   nlohmann::json Parameters() const override { return options_.ToJson(); }
   size_t MemoryBytes() const override {
     // Per node: its level-0 block, its upper-list pointer, its level, its lock and its slot
@@ -182,8 +250,15 @@ class HnswlibIndex : public KnnIndex {
       for (; !heap.empty(); heap.pop()) rows.push_back(static_cast<uint32_t>(heap.top().second));
       return Rerank(set().descriptors, query, rows, static_cast<int>(kk));
     }
+    std::vector<uint8_t> codes;
     const float* row = query.data();
-    auto heap = graph_->searchKnn(&row, kk);
+    const void* graph_query = &row;
+    if (sq8_) {
+      codes.resize(query.size());
+      Encode(query, sq8_->step, codes.data());
+      graph_query = codes.data();
+    }
+    auto heap = graph_->searchKnn(graph_query, kk);
     std::vector<std::pair<float, uint32_t>> found;
     found.reserve(heap.size());
     for (; !heap.empty(); heap.pop()) found.emplace_back(heap.top().first, static_cast<uint32_t>(heap.top().second));
@@ -194,6 +269,7 @@ class HnswlibIndex : public KnnIndex {
   std::vector<uint8_t> Body() const override {
     const Graph& g = *graph_;
     BodyWriter body;
+    if (sq8_) body.Put<float>(sq8_->step);
     if (options_.pca > 0) {
       body.PutArray<float>(mean_);
       body.PutArray<float>(components_);
@@ -218,6 +294,18 @@ class HnswlibIndex : public KnnIndex {
   }
 
  private:
+  void MakeGraph() {
+    graph_ = std::make_unique<Graph>(space_.get(), std::max<size_t>(size(), 1), options_.m, options_.ef_construction,
+                                     options_.seed);
+    graph_->setEf(options_.ef_search);
+  }
+
+  // Row i's codes, until the graph holds them.
+  const uint8_t* Codes(size_t i) const { return sq8_->codes.data() + i * config().Dimension(); }
+  void ReleaseCodes() {
+    if (sq8_) std::vector<uint8_t>().swap(sq8_->codes);
+  }
+
   // The row a graph node points to: the descriptor, or its projection.
   const float* GraphRow(size_t i) const {
     return options_.pca > 0 ? reduced_.data() + i * options_.pca : set().descriptors.Row(i).data();
@@ -260,7 +348,8 @@ class HnswlibIndex : public KnnIndex {
   }
 
   HnswOptions options_;
-  RowPointerSpace space_;
+  std::optional<Sq8Codes> sq8_;  // hnswlib-sq8: the step (and the codes until the graph holds them)
+  std::unique_ptr<hnswlib::SpaceInterface<float>> space_;
   std::unique_ptr<Graph> graph_;
   std::vector<float> mean_, components_;  // PCA: d, and pca x d row-major
   std::vector<float> reduced_;            // PCA: the rows projected, n x pca
@@ -275,6 +364,36 @@ std::unique_ptr<KnnIndex> BuildHnswlib(IndexedSet set, const HnswOptions& option
 std::unique_ptr<KnnIndex> LoadHnswlib(IndexedSet set, const HnswOptions& options, std::span<const uint8_t> body,
                                       const std::string& source) {
   return LoadAdapter<HnswlibIndex>(std::move(set), options, body, source);
+}
+
+std::unique_ptr<KnnIndex> BuildHnswlibSq8(IndexedSet set, const HnswOptions& options, std::ostream* progress) {
+  const std::vector<float>& values = set.descriptors.values();
+  Sq8Codes codes;
+  codes.step = CodeStep(values.empty() ? 0.0f : *std::max_element(values.begin(), values.end()));
+  const size_t d = static_cast<size_t>(set.descriptors.dimension());
+  codes.codes.resize(set.descriptors.rows() * d);
+  for (size_t r = 0; r < set.descriptors.rows(); ++r) Encode(set.descriptors.Row(r), codes.step, codes.codes.data() + r * d);
+  IndexedSet ids{DescriptorMatrix(set.descriptors.config(), 0), std::move(set.ids)};
+  set.descriptors = DescriptorMatrix(ids.descriptors.config(), 0);  // the float rows are not kept
+  auto index = std::make_unique<HnswlibIndex>(std::move(ids), std::move(codes), options);
+  index->Build(progress);
+  return index;
+}
+
+std::unique_ptr<KnnIndex> LoadHnswlibSq8(const Database& db, std::vector<entry_id_t> ids, const HnswOptions& options,
+                                         std::span<const uint8_t> body, const std::string& source) {
+  BodyReader reader(body, source);
+  Sq8Codes codes;
+  codes.step = reader.Get<float>();
+  NPHAND_THROW_CHECK(std::isfinite(codes.step) && codes.step > 0.0f, source, ": the 8-bit code step ", codes.step,
+                     " is not a positive number");
+  const size_t d = static_cast<size_t>(db.descriptor().Dimension());
+  codes.codes.resize(ids.size() * d);
+  ForEachRow(db, ids, [&](size_t row, std::span<const float> hog) { Encode(hog, codes.step, codes.codes.data() + row * d); });
+  auto index = std::make_unique<HnswlibIndex>(IndexedSet{DescriptorMatrix(db.descriptor(), 0), std::move(ids)},
+                                              std::move(codes), options);
+  index->Load(reader);
+  return index;
 }
 
 }  // namespace nphand

@@ -9,16 +9,33 @@
 
 namespace nphand {
 
-IndexedSet DatabaseDescriptors(const Database& db) {
+std::vector<entry_id_t> DatabaseHandIds(const Database& db) {
   std::vector<entry_id_t> ids;
-  for (size_t i = 0; i < db.size(); ++i) {
+  ScanRecords(db, [&](size_t i) {
     if (db.Meta(i).has_hand) ids.push_back(static_cast<entry_id_t>(i));
-  }
+  });
+  return ids;
+}
+
+void ForEachRow(const Database& db, std::span<const entry_id_t> ids,
+                const std::function<void(size_t row, std::span<const float> hog)>& visit) {
+  size_t row = 0;
+  ScanRecords(db, [&](size_t i) {
+    if (row < ids.size() && ids[row] == i) {
+      visit(row, db.Hog(i));
+      ++row;
+    }
+  });
+  NPHAND_CHECK(row == ids.size(), "the ids are not ascending entries of the database");
+}
+
+IndexedSet DatabaseDescriptors(const Database& db) { return DatabaseDescriptors(db, DatabaseHandIds(db)); }
+
+IndexedSet DatabaseDescriptors(const Database& db, std::vector<entry_id_t> ids) {
   DescriptorMatrix descriptors(db.descriptor(), ids.size());
-  for (size_t r = 0; r < ids.size(); ++r) {
-    const std::span<const float> hog = db.Hog(ids[r]);
-    std::copy(hog.begin(), hog.end(), descriptors.MutableRow(r).begin());
-  }
+  ForEachRow(db, ids, [&](size_t row, std::span<const float> hog) {
+    std::copy(hog.begin(), hog.end(), descriptors.MutableRow(row).begin());
+  });
   return {std::move(descriptors), std::move(ids)};
 }
 

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -34,8 +35,16 @@ struct IndexedSet {
   DescriptorMatrix descriptors;
   std::vector<entry_id_t> ids;
 };
+// The entries of `db` that show a hand, in order.
+std::vector<entry_id_t> DatabaseHandIds(const Database& db);
 // The stored descriptors of every entry of `db` that shows a hand (one contiguous copy).
 IndexedSet DatabaseDescriptors(const Database& db);
+// The same for the entries `ids` (ascending) of `db`.
+IndexedSet DatabaseDescriptors(const Database& db, std::vector<entry_id_t> ids);
+// Calls visit(row, descriptor) for each entry ids[row] (ascending) of `db`, in one pass
+// that leaves none of the file resident (see ScanRecords).
+void ForEachRow(const Database& db, std::span<const entry_id_t> ids,
+                const std::function<void(size_t row, std::span<const float> hog)>& visit);
 
 struct Neighbours {
   std::vector<entry_id_t> ids;   // nearest first
