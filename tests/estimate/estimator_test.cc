@@ -225,7 +225,7 @@ TEST_F(EstimatorTest, AHandBesideAFaceIsFound) {
   options.skin = SkinOptions{};
   Estimator estimator(*db_, *index_, RightHand(), options);
   SequenceOptions sequence;
-  sequence.frames = 4;
+  sequence.frames = 8;
   sequence.grasp = 13;
   sequence.face = true;
   sequence.seed = testing::kTestSeed;
@@ -239,7 +239,7 @@ TEST_F(EstimatorTest, AHandBesideAFaceIsFound) {
     const cv::Rect hand = cv::boundingRect(frame.labels == static_cast<int>(PixelLabel::kHand));
     found += (r.box & hand).area() > 0.5 * hand.area();
   }
-  EXPECT_GE(found, 3);
+  EXPECT_GE(found, 5) << "of 8 frames (some poses are not in the tiny database)";
 }
 
 TEST_F(EstimatorTest, RenderedSequenceFramesAreEstimatedWithEveryField) {

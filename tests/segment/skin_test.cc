@@ -16,9 +16,9 @@ double IoU(const cv::Mat& a, const cv::Mat& b) {
 
 // Every skin region as a frame-sized mask (an object can split the hand into pieces).
 cv::Mat Regions(const SkinSegmentation& segmentation) {
-  cv::Mat mask = cv::Mat::zeros(segmentation.skin.size(), CV_8UC1);
-  for (const SkinRegion& region : segmentation.regions) mask |= segmentation.labels == region.label;
-  return mask;
+  std::vector<int> labels;
+  for (const SkinRegion& region : segmentation.regions) labels.push_back(region.label);
+  return segmentation.Mask(labels, cv::Rect(cv::Point(0, 0), segmentation.frame));
 }
 
 SkinOptions NoFaces() {
@@ -49,6 +49,43 @@ TEST(SkinTest, RenderedHandsOfEveryToneOnEveryBackgroundMatchTheirLabels) {
         EXPECT_GE(iou, 0.95) << tone.name << " on " << background << ", frame " << i << ", grasp " << sequence.grasp();
         ++frames;
       }
+    }
+  }
+}
+
+// A 640 x 480 frame is segmented at 320 x 240; its regions come back at the frame's size,
+// matching the labels as well as a segmentation at full size does, and agreeing with it.
+TEST(SkinTest, WideFramesAreSegmentedAtHalfSizeAndComeBackWhole) {
+  SkinOptions full = NoFaces();
+  full.work_width = 0;
+  SkinSegmenter half_size(NoFaces()), full_size(full);
+  int frames = 0;
+  for (const char* tone : {"light", "brown", "dark"}) {
+    for (BackgroundKind background : {BackgroundKind::kPlain, BackgroundKind::kTexture, BackgroundKind::kClutter}) {
+      SequenceOptions options;
+      options.frames = 10;
+      options.skin = tone;
+      options.background = background;
+      options.forearm = ForearmKind::kNone;
+      options.distance_m = 0.3;
+      options.seed = testing::kTestSeed + 100 + frames++;
+      Sequence sequence(testing::RightHand(), options);
+      const SequenceFrame frame = sequence.Render(4);
+      const SkinSegmentation half = half_size.Segment(frame.rgb), whole = full_size.Segment(frame.rgb);
+      EXPECT_EQ(half.scale, 2);
+      EXPECT_EQ(half.skin.size(), cv::Size(320, 240));
+      EXPECT_EQ(whole.scale, 1);
+      const cv::Mat truth = frame.labels == static_cast<int>(PixelLabel::kHand);
+      EXPECT_GE(IoU(Regions(half), truth), 0.95) << tone << ", frame " << frames;
+      EXPECT_GE(IoU(Regions(half), Regions(whole)), 0.97) << tone << ", frame " << frames;
+      ASSERT_FALSE(half.regions.empty());
+      // The largest region's box, area and centroid are its pixels' at the frame's size.
+      const cv::Mat region = half.RegionMask(half.regions[0]);
+      EXPECT_EQ(region.size(), half.regions[0].box.size());
+      EXPECT_NEAR(cv::countNonZero(region), half.regions[0].area, 0.05 * half.regions[0].area);
+      const cv::Moments m = cv::moments(region, true);
+      EXPECT_NEAR(half.regions[0].box.x + m.m10 / m.m00, half.regions[0].centroid.x, 1.0);
+      EXPECT_NEAR(half.regions[0].box.y + m.m01 / m.m00, half.regions[0].centroid.y, 1.0);
     }
   }
 }
@@ -102,6 +139,9 @@ TEST(SkinTest, BadInputIsRefused) {
   SkinOptions options = NoFaces();
   options.cr_min = 200;
   testing::ExpectError([&] { SkinSegmenter bad(options); }, "min <= max");
+  options = NoFaces();
+  options.work_width = 10;
+  testing::ExpectError([&] { SkinSegmenter bad(options); }, "working width");
   options = SkinOptions{};
   options.face_cascade = "/nonexistent/cascade.xml";
   testing::ExpectError([&] { SkinSegmenter bad(options); }, "no face cascade");

@@ -1,9 +1,9 @@
 #include "nphand/estimate/estimator.h"
 
 #include <algorithm>
-#include <cmath>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <numbers>
 
 #include <opencv2/imgproc.hpp>
@@ -12,6 +12,7 @@
 #include "nphand/features/descriptor.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/util/check.h"
+#include "nphand/util/parallel.h"
 
 namespace nphand {
 namespace {
@@ -22,19 +23,23 @@ double Ms(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::milli>(to - from).count();
 }
 
-// A hand region together with the pieces an object splits off it: skin regions whose boxes
-// meet the region's box grown by 30 % of its longer side.
+// A hand region together with the pieces an object splits off it (skin regions whose boxes
+// meet the region's box grown by 30 % of its longer side): their pixels within `*box`, which
+// gets the pixels' bounds.
 cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, cv::Rect* box) {
   const int grow = static_cast<int>(0.3 * std::max(seed.box.width, seed.box.height));
   const cv::Rect reach(seed.box.x - grow, seed.box.y - grow, seed.box.width + 2 * grow, seed.box.height + 2 * grow);
-  cv::Mat mask = s.labels == seed.label;
-  *box = seed.box;
+  std::vector<int> labels = {seed.label};
+  cv::Rect bounds = seed.box;
   for (const SkinRegion& r : s.regions) {
     if (r.label == seed.label || (r.box & reach).area() == 0) continue;
-    mask |= s.labels == r.label;
-    *box |= r.box;
+    labels.push_back(r.label);
+    bounds |= r.box;
   }
-  return mask;
+  const cv::Mat mask = s.Mask(labels, bounds);
+  const cv::Rect tight = cv::boundingRect(mask);
+  *box = tight + bounds.tl();
+  return mask(tight);
 }
 
 int Border(const cv::Rect& box, const cv::Size& frame) {
@@ -180,6 +185,36 @@ Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel&
   directions_ = ViewSphereDirections(db.header()["viewpoints"].get<int>());
   grasps_.resize(kNumGrasps + 1);
   model_hand_length_ = ModelHandLength(db);
+  entries_.resize(db.size());
+  std::array<bool, kNumGrasps + 1> with_object{};
+  ScanRecords(db, [&](size_t i) {
+    EntryRow& row = entries_[i];
+    row.meta = db.Meta(i);
+    const PoseVector pose = db.Pose(i);
+    const JointAngles angles = db.Angles(i);
+    for (int j = 0; j < kPoseVectorSize; ++j) row.pose[j] = static_cast<float>(pose[j]);
+    for (int j = 0; j < kNumDofs; ++j) row.angles[j] = static_cast<float>(angles[j]);
+    with_object[row.meta.grasp] = with_object[row.meta.grasp] || row.meta.with_object;
+  });
+  // The grasps whose objects the database shows, closed onto them now, on every core: a
+  // grasp takes about 100 ms, far too long to make on the frame that first needs it.
+  std::vector<int> held;
+  for (int id = 1; id <= kNumGrasps; ++id) {
+    if (with_object[id]) held.push_back(id);
+  }
+  ParallelFor(held.size(), 0, [&](size_t i, int) { grasps_[held[i]] = MakeGrasp(hand_, GraspTaxonomy()[held[i] - 1]); });
+}
+
+PoseVector Estimator::PoseOf(uint32_t entry) const {
+  PoseVector pose;
+  for (int j = 0; j < kPoseVectorSize; ++j) pose[j] = entries_[entry].pose[j];
+  return pose;
+}
+
+JointAngles Estimator::AnglesOf(uint32_t entry) const {
+  JointAngles angles;
+  for (int j = 0; j < kNumDofs; ++j) angles[j] = entries_[entry].angles[j];
+  return angles;
 }
 
 void Estimator::Reset() {
@@ -198,16 +233,15 @@ const Intrinsics& Estimator::intrinsics_for(cv::Size frame) const {
   return frame_intrinsics_;
 }
 
-const Grasp& Estimator::GraspOf(int id) {
-  NPHAND_CHECK(id >= 1 && id <= kNumGrasps, "grasp ", id);
-  if (!grasps_[id].has_value()) grasps_[id] = MakeGrasp(hand_, GraspTaxonomy()[id - 1]);
+const Grasp& Estimator::GraspOf(int id) const {
+  NPHAND_CHECK(id >= 1 && id <= kNumGrasps && grasps_[id].has_value(), "grasp ", id, " was not made");
   return *grasps_[id];
 }
 
 Scene Estimator::EntryScene(uint32_t entry) {
-  const EntryMeta meta = db_.Meta(entry);
+  const EntryMeta meta = entries_[entry].meta;
   Scene scene;
-  scene.hand.angles = db_.Angles(entry);
+  scene.hand.angles = AnglesOf(entry);
   scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(directions_[meta.viewpoint]));
   scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, hand_.bind_centre(), db_distance_);
   if (meta.with_object) scene.objects = {GraspOf(meta.grasp).object};
@@ -253,16 +287,16 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
   for (size_t c = 0; c < std::min<size_t>(2, candidates.size()); ++c) {
     const Clock::time_point part = Clock::now();
     cv::Rect box;
-    cv::Mat hand = GatherHand(skin, *candidates[c], &box);
+    const cv::Mat region = GatherHand(skin, *candidates[c], &box);
+    cv::Mat hand = cv::Mat::zeros(bgr.size(), CV_8UC1);
     bool cut = false;
     if (options_.cut_forearm) {
-      const ForearmCut forearm = CutForearm(hand(box), Border(box, bgr.size()), options_.forearm);
+      const ForearmCut forearm = CutForearm(region, Border(box, bgr.size()), options_.forearm);
       cut = forearm.cut;
-      if (cut) {
-        hand = cv::Mat::zeros(bgr.size(), CV_8UC1);
-        forearm.hand.copyTo(hand(box));
-        box = cv::boundingRect(hand);
-      }
+      forearm.hand.copyTo(hand(box));
+      if (cut) box = cv::boundingRect(hand);
+    } else {
+      region.copyTo(hand(box));
     }
     result.ms.segment += Ms(part, Clock::now());
     const bool left = options_.hand == Handedness::kLeft;
@@ -356,9 +390,9 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
       h.entry = found[c].ids[i];
       h.turn_of = static_cast<int>(c);
       h.distance = std::sqrt(std::max(0.0f, found[c].distances[i]));
-      h.meta = db_.Meta(h.entry);
+      h.meta = entries_[h.entry].meta;
       h.turn = config.normalize_roll ? std::remainder(crops[c].roll - h.meta.roll, 2.0 * std::numbers::pi) : 0.0;
-      const PoseVector pose = db_.Pose(h.entry);
+      const PoseVector pose = PoseOf(h.entry);
       Eigen::Matrix3d entry_rotation;
       for (int r = 0; r < 3; ++r) {
         for (int col = 0; col < 3; ++col) entry_rotation(r, col) = pose[3 * r + col];
@@ -456,7 +490,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
     out.weight = h.w;
     out.distance = h.distance;
     out.turn = h.turn;
-    out.pose.angles = db_.Angles(h.entry);
+    out.pose.angles = AnglesOf(h.entry);
     out.pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), h.turn) *
                                 CameraFromHand(ViewpointFromDirection(directions_[h.meta.viewpoint]));
     result.top.push_back(out);
@@ -475,7 +509,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   NPHAND_CHECK(entry_crop.has_value(), "entry ", best.entry, " has no hand to crop");
   const HandCrop& query_crop = crops[best.turn_of];
   const cv::Matx23d frame_from_crop = Invert(query_crop.crop_from_image);
-  const Keypoints3d entry_keypoints = db_.Keypoints(best.entry);
+  const Keypoints3d entry_keypoints = hand_.KeypointsOf(scene.hand);
   const double size = options_.hand_length_m / model_hand_length_;
   const Intrinsics& camera = intrinsics_for(frame);
   // A pixel of the database's render (pixel centres at +0.5) to the frame's.

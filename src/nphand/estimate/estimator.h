@@ -161,10 +161,21 @@ class Estimator {
   // time filled in. A region unlike any view leaves the carried hypotheses as they were
   // (the caller may try another region, and forgets them if none is a hand).
   FrameResult Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result);
-  const Grasp& GraspOf(int id);
+  const Grasp& GraspOf(int id) const;
   Scene EntryScene(uint32_t entry);
 
+  // What a frame needs of an entry, copied from the database once: frames then never touch
+  // the mapped file, whose pages would otherwise pile up in resident memory.
+  struct EntryRow {
+    EntryMeta meta;
+    std::array<float, kPoseVectorSize> pose;
+    std::array<float, kNumDofs> angles;
+  };
+  PoseVector PoseOf(uint32_t entry) const;
+  JointAngles AnglesOf(uint32_t entry) const;
+
   const Database& db_;
+  std::vector<EntryRow> entries_;  // by entry number
   const KnnIndex& index_;
   const HandModel& hand_;
   EstimatorOptions options_;
@@ -173,7 +184,7 @@ class Estimator {
   Intrinsics db_intrinsics_;
   double db_distance_ = 0.5;
   std::vector<Eigen::Vector3d> directions_;
-  std::vector<std::optional<Grasp>> grasps_;  // by taxonomy number, made when first needed
+  std::vector<std::optional<Grasp>> grasps_;  // by taxonomy number: those the database holds with an object
   double model_hand_length_ = 0.0;
   mutable Intrinsics frame_intrinsics_;
   std::vector<WeightedPose> carried_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/objdetect.hpp>
@@ -29,15 +30,15 @@ bool SkinOptions::Check(std::string* why) const {
     *why = "the smallest skin region must be within (0, 1) of the frame";
   } else if (face_interval < 1) {
     *why = "the face interval must be at least 1 frame";
+  } else if (work_width != 0 && work_width < 64) {
+    *why = "the working width must be 0 (the frame's) or at least 64 pixels";
   } else {
     return true;
   }
   return false;
 }
 
-cv::Mat SkinSegmentation::RegionMask(const SkinRegion& region) const {
-  return labels(region.box) == region.label;
-}
+cv::Mat SkinSegmentation::RegionMask(const SkinRegion& region) const { return Mask({region.label}, region.box); }
 
 SkinSegmenter::SkinSegmenter(const SkinOptions& options) : options_(options) {
   std::string why;
@@ -83,12 +84,52 @@ void SkinSegmenter::RebuildLookup() {
   }
 }
 
+namespace {
+
+// `bgr` halved (2 x 2 pixel means) until at most `width` wide (0: as it is); `scale` gets
+// the frame's pixels per pixel of the result.
+cv::Mat Working(const cv::Mat& bgr, int width, int* scale) {
+  cv::Mat work = bgr;
+  *scale = 1;
+  while (width > 0 && work.cols > width) {
+    cv::Mat half;
+    cv::resize(work, half, cv::Size((work.cols + 1) / 2, (work.rows + 1) / 2), 0.0, 0.0, cv::INTER_AREA);
+    work = half;
+    *scale *= 2;
+  }
+  return work;
+}
+
+}  // namespace
+
+cv::Mat SkinSegmentation::Mask(const std::vector<int>& which, cv::Rect box) const {
+  box &= cv::Rect(0, 0, frame.width, frame.height);
+  if (scale == 1) {
+    cv::Mat mask = cv::Mat::zeros(box.size(), CV_8UC1);
+    for (int label : which) mask |= labels(box) == label;
+    return mask;
+  }
+  // The working pixels under the box and one more each way, their mask interpolated up to
+  // the frame's pixels and cut at half: edges fall between working pixels, not on them.
+  const int x0 = box.x / scale - 1, y0 = box.y / scale - 1;
+  const int x1 = (box.x + box.width + scale - 1) / scale + 1, y1 = (box.y + box.height + scale - 1) / scale + 1;
+  const cv::Rect under = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(0, 0, labels.cols, labels.rows);
+  cv::Mat small = cv::Mat::zeros(under.size(), CV_8UC1);
+  for (int label : which) small |= labels(under) == label;
+  cv::Mat large;
+  cv::resize(small, large, cv::Size(under.width * scale, under.height * scale), 0.0, 0.0, cv::INTER_LINEAR);
+  return large(cv::Rect(box.x - under.x * scale, box.y - under.y * scale, box.width, box.height)) >= 128;
+}
+
 SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   NPHAND_THROW_CHECK(!bgr.empty() && bgr.type() == CV_8UC3, "skin: a frame must be a non-empty 8-bit BGR image");
-  cv::Mat ycrcb;
-  cv::cvtColor(bgr, ycrcb, cv::COLOR_BGR2YCrCb);
   SkinSegmentation out;
-  out.skin.create(bgr.size(), CV_8UC1);
+  out.frame = bgr.size();
+  const cv::Mat work = Working(bgr, options_.work_width, &out.scale);
+  const int scale = out.scale;
+  cv::Mat ycrcb;
+  cv::cvtColor(work, ycrcb, cv::COLOR_BGR2YCrCb);
+  out.skin.create(work.size(), CV_8UC1);
   for (int y = 0; y < ycrcb.rows; ++y) {
     const cv::Vec3b* in = ycrcb.ptr<cv::Vec3b>(y);
     uint8_t* skin = out.skin.ptr<uint8_t>(y);
@@ -96,13 +137,15 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
       skin[x] = in[x][0] >= options_.y_min ? lookup_.at<uint8_t>(in[x][1], in[x][2]) : 0;
     }
   }
+  // A size in frame pixels at the working resolution: odd, so that the kernel is centred.
+  auto working = [&](int px) { return ((px + scale - 1) / scale) | 1; };
   if (options_.open_px > 1) {
-    cv::morphologyEx(out.skin, out.skin, cv::MORPH_OPEN,
-                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(options_.open_px, options_.open_px)));
+    const int k = working(options_.open_px);
+    cv::morphologyEx(out.skin, out.skin, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
   }
   if (options_.close_px > 1) {
-    cv::morphologyEx(out.skin, out.skin, cv::MORPH_CLOSE,
-                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(options_.close_px, options_.close_px)));
+    const int k = working(options_.close_px);
+    cv::morphologyEx(out.skin, out.skin, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
   }
 
   // Faces: looked for every face_interval frames, and at once when the regions changed in
@@ -112,46 +155,74 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   const bool look = frames_ % options_.face_interval == 0 || regions_changed_;
   ++frames_;
   if (detector_ != nullptr && look) {
-    cv::Mat grey;
-    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-    double scale = 1.0;
-    while (grey.cols > 320) {
-      cv::pyrDown(grey, grey);
-      scale *= 2.0;
-    }
-    cv::equalizeHist(grey, grey);
-    std::vector<cv::Rect> found;
-    detector_->cascade.detectMultiScale(grey, found, 1.1, 4, 0, cv::Size(24, 24));
+    // A face is skin: the cascade looks only around skin regions that could hold one (their
+    // box grown by a quarter of a side each way, for the hair and a face cut by a hand), on
+    // the frame halved until it is at most 320 pixels wide.
+    int halvings = 0;
+    for (int width = work.cols; width > 320; width = (width + 1) / 2) ++halvings;
+    const int look_scale = 1 << halvings;  // working pixels per looked-at pixel
+    constexpr int kMinFace = 24;           // pixels, in the looked-at frame
+    cv::Mat stats, centroids, labels;
+    const int count = cv::connectedComponentsWithStats(out.skin, labels, stats, centroids, 8, CV_32S);
+    std::vector<cv::Rect> looked;
     faces_.clear();
-    for (const cv::Rect& f : found) {
-      faces_.emplace_back(static_cast<int>(f.x * scale), static_cast<int>(f.y * scale), static_cast<int>(f.width * scale),
-                          static_cast<int>(f.height * scale));
+    for (int label = 1; label < count; ++label) {
+      const cv::Rect box(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
+                         stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+      if (box.width < kMinFace * look_scale / 2 || box.height < kMinFace * look_scale / 2) continue;
+      const cv::Rect roi =
+          cv::Rect(box.x - box.width / 4, box.y - box.height / 4, box.width * 3 / 2, box.height * 3 / 2) &
+          cv::Rect(0, 0, work.cols, work.rows);
+      if (std::any_of(looked.begin(), looked.end(), [&](const cv::Rect& r) { return (r & roi) == roi; })) continue;
+      looked.push_back(roi);
+      cv::Mat grey;
+      cv::cvtColor(work(roi), grey, cv::COLOR_BGR2GRAY);
+      for (int h = 0; h < halvings; ++h) cv::pyrDown(grey, grey);
+      if (grey.cols < kMinFace || grey.rows < kMinFace) continue;
+      cv::equalizeHist(grey, grey);
+      std::vector<cv::Rect> found;
+      detector_->cascade.detectMultiScale(grey, found, 1.1, 4, 0, cv::Size(kMinFace, kMinFace));
+      const int to_frame = look_scale * scale;
+      for (const cv::Rect& f : found) {
+        const cv::Rect face(roi.x * scale + f.x * to_frame, roi.y * scale + f.y * to_frame, f.width * to_frame,
+                            f.height * to_frame);
+        if (std::none_of(faces_.begin(), faces_.end(), [&](const cv::Rect& g) { return (g & face).area() > 0; })) {
+          faces_.push_back(face);
+        }
+      }
     }
   }
   out.faces = faces_;
   if (!faces_.empty()) {
-    cv::Mat face_mask = cv::Mat::zeros(bgr.size(), CV_8UC1);
-    for (const cv::Rect& f : faces_) {
+    cv::Mat face_mask = cv::Mat::zeros(work.size(), CV_8UC1);
+    for (const cv::Rect& frame_face : faces_) {
+      const cv::Rect f(frame_face.x / scale, frame_face.y / scale, frame_face.width / scale, frame_face.height / scale);
       const cv::Point centre(f.x + f.width / 2, f.y + f.height / 2);
       cv::ellipse(face_mask, centre, cv::Size(f.width * 7 / 10, f.height * 9 / 10), 0, 0, 360, cv::Scalar(255), cv::FILLED);
       cv::rectangle(face_mask, cv::Rect(f.x + f.width / 5, centre.y, f.width * 3 / 5, f.height * 3 / 2), cv::Scalar(255),
                     cv::FILLED);
     }
-    out.face_pixels = cv::countNonZero(out.skin & face_mask);
+    out.face_pixels = cv::countNonZero(out.skin & face_mask) * scale * scale;
     out.skin.setTo(0, face_mask);
   }
 
   cv::Mat stats, centroids;
   const int count = cv::connectedComponentsWithStats(out.skin, out.labels, stats, centroids, 8, CV_32S);
-  const int min_area = std::max(1, static_cast<int>(options_.min_area * bgr.total()));
+  const int min_area = std::max(1, static_cast<int>(options_.min_area * work.total()));
+  const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
   for (int label = 1; label < count; ++label) {
     SkinRegion region;
     region.label = label;
-    region.area = stats.at<int>(label, cv::CC_STAT_AREA);
-    if (region.area < min_area) continue;
-    region.box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
-                          stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
-    region.centroid = cv::Point2d(centroids.at<double>(label, 0), centroids.at<double>(label, 1));
+    const int area = stats.at<int>(label, cv::CC_STAT_AREA);
+    if (area < min_area) continue;
+    region.area = area * scale * scale;
+    region.box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT) * scale, stats.at<int>(label, cv::CC_STAT_TOP) * scale,
+                          stats.at<int>(label, cv::CC_STAT_WIDTH) * scale,
+                          stats.at<int>(label, cv::CC_STAT_HEIGHT) * scale) &
+                 frame;
+    // A working pixel's centre in the frame's pixel coordinates.
+    region.centroid = cv::Point2d((centroids.at<double>(label, 0) + 0.5) * scale - 0.5,
+                                  (centroids.at<double>(label, 1) + 0.5) * scale - 0.5);
     out.regions.push_back(region);
   }
   regions_changed_ = static_cast<int>(out.regions.size()) != last_regions_;
@@ -165,12 +236,19 @@ void SkinSegmenter::Learn(const cv::Mat& bgr, const cv::Mat& hand) {
   if (!options_.adapt) return;
   NPHAND_THROW_CHECK(!bgr.empty() && bgr.type() == CV_8UC3 && hand.type() == CV_8UC1 && hand.size() == bgr.size(),
                      "skin: learning needs a BGR frame and a hand mask of its size");
+  // At the working resolution, as Segment sees the frame.
+  int scale = 1;
+  const cv::Mat work = Working(bgr, options_.work_width, &scale);
+  cv::Mat hand_work = hand != 0;
+  if (scale > 1) cv::resize(hand_work, hand_work, work.size(), 0.0, 0.0, cv::INTER_AREA);
   cv::Mat ycrcb;
-  cv::cvtColor(bgr, ycrcb, cv::COLOR_BGR2YCrCb);
-  // The hand's inside (its edges mix with the background) against everything not near it.
+  cv::cvtColor(work, ycrcb, cv::COLOR_BGR2YCrCb);
+  // The hand's inside (its edges mix with the background) against everything not near it:
+  // 2 and 7 frame pixels, in working pixels.
+  const int erode_px = 2 * std::max(1, 2 / scale) + 1, dilate_px = 2 * std::max(1, 7 / scale) + 1;
   cv::Mat inner, near;
-  cv::erode(hand, inner, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
-  cv::dilate(hand, near, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(15, 15)));
+  cv::erode(hand_work >= 128, inner, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(erode_px, erode_px)));
+  cv::dilate(hand_work != 0, near, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(dilate_px, dilate_px)));
   if (cv::countNonZero(inner) < 50) return;
   const int channels[] = {1, 2};
   const int sizes[] = {options_.bins, options_.bins};

@@ -29,17 +29,25 @@ struct SkinOptions {
   double keep = 0.25;
   double add = 0.8;
   int bins = 32;                // per chroma axis
+  // Frames wider than this are halved (2 x 2 means) until they are not, and segmented at
+  // that working resolution (0: at the frame's own); region masks come back at the frame's
+  // resolution, their edges interpolated. A 640 x 480 frame is segmented at 320 x 240.
+  int work_width = 320;
+  // Morphology, in frame pixels (at the working resolution: divided by its scale, rounded
+  // up to an odd size).
   int open_px = 3;              // opening removes specks (0: none)
-  int close_px = 5;             // closing fills cracks; holes wider than this stay (the object's)
+  int close_px = 5;             // closing fills cracks; wider holes stay (the object's)
   double min_area = 0.0003;     // smallest region, as a fraction of the frame (fingertips past an object count)
   // Faces: the cascade's file ("" finds none), run every face_interval frames and whenever
-  // the skin regions changed in number, on a frame halved until it is at most 320 pixels
-  // wide; each face's head and neck are set aside from the skin.
+  // the skin regions changed in number, around the skin regions large enough to hold a
+  // face, on the frame halved until it is at most 320 pixels wide; each face's head and
+  // neck are set aside from the skin.
   std::string face_cascade = kDefaultFaceCascade;
   int face_interval = 30;
   bool Check(std::string* why) const;
 };
 
+// A connected skin region, in the frame's pixels.
 struct SkinRegion {
   int label = 0;              // in SkinSegmentation::labels
   cv::Rect box;
@@ -48,12 +56,17 @@ struct SkinRegion {
 };
 
 struct SkinSegmentation {
-  cv::Mat skin;                     // CV_8UC1, 255 = skin (cleaned, faces set aside)
-  cv::Mat labels;                   // CV_32SC1, connected regions of `skin` (0: none)
+  cv::Size frame;                   // the frame's size
+  int scale = 1;                    // frame pixels per working pixel (a power of 2)
+  cv::Mat skin;                     // CV_8UC1, working resolution, 255 = skin (cleaned, faces set aside)
+  cv::Mat labels;                   // CV_32SC1, working resolution, connected regions of `skin` (0: none)
   std::vector<SkinRegion> regions;  // at least min_area, largest first
-  std::vector<cv::Rect> faces;      // the faces in view (the last detection's)
-  int face_pixels = 0;              // skin pixels set aside as faces (heads and necks)
-  // The pixels of one region within its box (CV_8UC1, 255 = the region).
+  std::vector<cv::Rect> faces;      // the faces in view (the last detection's), frame pixels
+  int face_pixels = 0;              // frame pixels of skin set aside as faces (heads and necks)
+  // The pixels of the regions labelled `which` within `box` (frame pixels), at the frame's
+  // resolution: CV_8UC1 of the box's size, 255 = skin.
+  cv::Mat Mask(const std::vector<int>& which, cv::Rect box) const;
+  // The pixels of one region within its box.
   cv::Mat RegionMask(const SkinRegion& region) const;
 };
 
