@@ -68,7 +68,7 @@ cp "$root/.cache/hand/right.glb" "$root/.cache/hand/left.glb" "$seeds/glb/"
 "$build/apps/nphand" index build --db "$seeds/tiny.db" --out "$seeds/index/tiny.idx" >/dev/null
 # index_body: a backend byte (the target's order) and a real body of that backend.
 selector=0
-for backend in faiss-hnsw hnswlib faiss-ivf; do
+for backend in faiss-hnsw hnswlib hnswlib-sq8 faiss-ivf; do
   "$build/apps/nphand" index build --db "$seeds/tiny.db" --backend "$backend" --out "$seeds/$backend.idx" >/dev/null 2>&1
   python3 - "$seeds/$backend.idx" "$seeds/index_body/$backend" "$selector" <<'PY'
 import struct, sys

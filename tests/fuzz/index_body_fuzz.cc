@@ -1,7 +1,7 @@
 // Fuzzes the index backends' body decoders behind a valid checksum: the first byte picks a
-// backend with a body (faiss-hnsw, hnswlib, faiss-ivf), the rest is its body. The meta is
-// that of a real index of the seed database scripts/fuzz.sh names in NPHAND_FUZZ_DB, so
-// every input reaches the decoder; a decoded index is searched.
+// backend with a body (faiss-hnsw, hnswlib, hnswlib-sq8, faiss-ivf), the rest is its body.
+// The meta is that of a real index of the seed database scripts/fuzz.sh names in
+// NPHAND_FUZZ_DB, so every input reaches the decoder; a decoded index is searched.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -15,7 +15,7 @@
 
 namespace {
 
-const char* const kBackends[] = {"faiss-hnsw", "hnswlib", "faiss-ivf"};
+const char* const kBackends[] = {"faiss-hnsw", "hnswlib", "hnswlib-sq8", "faiss-ivf"};
 
 struct Seed {
   std::unique_ptr<nphand::Database> db;

@@ -117,11 +117,12 @@ class HnswlibIndex : public KnnIndex {
                        " dimensions of a ", config().Dimension(), "-dimensional descriptor");
     MakeGraph();
   }
-  // "hnswlib-sq8": the nodes hold the rows' codes; `ids` has no descriptor rows.
+  // "hnswlib-sq8": the nodes hold the rows' codes; `ids` has no descriptor rows. The codes
+  // are given to Build; a loaded index gets them from EncodeRows.
   HnswlibIndex(IndexedSet ids, Sq8Codes codes, const HnswOptions& options)
       : KnnIndex(std::move(ids)), options_(options), sq8_(std::move(codes)),
         space_(std::make_unique<CodeSpace>(static_cast<size_t>(config().Dimension()), sq8_->step)) {
-    NPHAND_CHECK(options.pca == 0 && sq8_->codes.size() == size() * config().Dimension());
+    NPHAND_CHECK(options.pca == 0 && (sq8_->codes.empty() || sq8_->codes.size() == size() * config().Dimension()));
     MakeGraph();
   }
 
@@ -202,9 +203,7 @@ class HnswlibIndex : public KnnIndex {
         g.linkLists_[i] = static_cast<char*>(std::calloc(bytes, 1));
         NPHAND_THROW_CHECK(g.linkLists_[i] != nullptr, body.source(), ": out of memory for the HNSW graph");
       }
-      if (sq8_) {
-        std::memcpy(g.getDataByInternalId(static_cast<hnswlib::tableint>(i)), Codes(i), config().Dimension());
-      } else {
+      if (!sq8_) {
         const float* row = GraphRow(i);
         std::memcpy(g.getDataByInternalId(static_cast<hnswlib::tableint>(i)), &row, sizeof(row));
       }
@@ -217,7 +216,15 @@ class HnswlibIndex : public KnnIndex {
     NPHAND_THROW_CHECK(at == links.size(), body.source(), ": ", links.size() - at, " link values after the last list");
     g.enterpoint_node_ = n == 0 ? static_cast<hnswlib::tableint>(-1) : entry;
     g.maxlevel_ = top;
-    ReleaseCodes();
+  }
+
+  // hnswlib-sq8, after Load: every node's codes, encoded from `db` in one pass straight into
+  // the graph (no second copy of them, however briefly).
+  void EncodeRows(const Database& db) {
+    ForEachRow(db, set().ids, [&](size_t row, std::span<const float> hog) {
+      Encode(hog, sq8_->step,
+             reinterpret_cast<uint8_t*>(graph_->getDataByInternalId(static_cast<hnswlib::tableint>(row))));
+    });
   }
 
   std::string Backend() const override { return sq8_ ? "hnswlib-sq8" : "hnswlib"; }
@@ -348,7 +355,7 @@ class HnswlibIndex : public KnnIndex {
   }
 
   HnswOptions options_;
-  std::optional<Sq8Codes> sq8_;  // hnswlib-sq8: the step (and the codes until the graph holds them)
+  std::optional<Sq8Codes> sq8_;  // hnswlib-sq8: the step (and, while building, the codes)
   std::unique_ptr<hnswlib::SpaceInterface<float>> space_;
   std::unique_ptr<Graph> graph_;
   std::vector<float> mean_, components_;  // PCA: d, and pca x d row-major
@@ -387,12 +394,10 @@ std::unique_ptr<KnnIndex> LoadHnswlibSq8(const Database& db, std::vector<entry_i
   codes.step = reader.Get<float>();
   NPHAND_THROW_CHECK(std::isfinite(codes.step) && codes.step > 0.0f, source, ": the 8-bit code step ", codes.step,
                      " is not a positive number");
-  const size_t d = static_cast<size_t>(db.descriptor().Dimension());
-  codes.codes.resize(ids.size() * d);
-  ForEachRow(db, ids, [&](size_t row, std::span<const float> hog) { Encode(hog, codes.step, codes.codes.data() + row * d); });
   auto index = std::make_unique<HnswlibIndex>(IndexedSet{DescriptorMatrix(db.descriptor(), 0), std::move(ids)},
                                               std::move(codes), options);
   index->Load(reader);
+  index->EncodeRows(db);
   return index;
 }
 
