@@ -6,11 +6,13 @@
 #include <fstream>
 #include <iomanip>
 #include <numbers>
+#include <span>
 #include <sstream>
 
 #include <Eigen/Core>
 #include <opencv2/imgproc.hpp>
 
+#include "nphand/eval/measures.h"
 #include "nphand/model/hand_model.h"
 #include "nphand/model/hand_pose.h"
 #include "nphand/model/skeleton.h"
@@ -19,7 +21,8 @@
 namespace nphand {
 namespace {
 
-constexpr std::array<const char*, 5> kMeasures = {"joint_deg", "wrist_deg", "keypoint_mm", "keypoint_px", "camera_mm"};
+constexpr std::array<const char*, 6> kMeasures = {"joint_deg",   "wrist_deg", "keypoint_mm",
+                                                   "keypoint_px", "camera_mm", "pa_mpjpe_mm"};
 
 std::vector<nlohmann::json> ReadLines(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -79,6 +82,11 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
                      truth_path.string(), " only ", truth.size());
   PoseErrorSummary summary;
   std::array<std::vector<double>, kMeasures.size()> values;
+  std::vector<double> distances;  // every keypoint's, about the wrist
+  // Hand keypoints (metres, about the wrist) of the detected frames, estimate and truth, with
+  // their frame numbers: for jitter.
+  std::vector<Keypoints3d> estimated, true_keypoints;
+  std::vector<int> detected_frames;
   for (size_t i = 0; i < poses.size(); ++i) {
     const nlohmann::json& p = poses[i];
     const nlohmann::json& t = truth[i];
@@ -115,13 +123,23 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
                              tc.size() == kNumKeypoints && k2.size() == kNumKeypoints && t2.size() == kNumKeypoints,
                          poses_path.string(), ": line ", i + 1, ": keypoints must be 21");
       const double scale = ChainLength(th) / std::max(ChainLength(kh), 1e-9);
+      Keypoints3d estimate, truth_hand;
       for (int k = 0; k < kNumKeypoints; ++k) {
-        e.keypoint_mm += 1000.0 * std::hypot(scale * kh[k][0] - th[k][0], scale * kh[k][1] - th[k][1], scale * kh[k][2] - th[k][2]) / kNumKeypoints;
+        estimate[k] = scale * Eigen::Vector3d(kh[k][0], kh[k][1], kh[k][2]);
+        truth_hand[k] = Eigen::Vector3d(th[k][0], th[k][1], th[k][2]);
+        const double d = (estimate[k] - truth_hand[k]).norm();
+        distances.push_back(d);
+        e.keypoint_mm += 1000.0 * d / kNumKeypoints;
         e.camera_mm += 1000.0 * std::hypot(kc[k][0] - tc[k][0], kc[k][1] - tc[k][1], kc[k][2] - tc[k][2]) / kNumKeypoints;
         e.keypoint_px += std::hypot(k2[k][0] - t2[k][0], k2[k][1] - t2[k][1]) / kNumKeypoints;
       }
+      e.pa_mpjpe_mm = 1000.0 * ProcrustesError(estimate, truth_hand);
+      estimated.push_back(estimate);
+      true_keypoints.push_back(truth_hand);
+      detected_frames.push_back(e.frame);
       ++summary.detected;
-      const std::array<double, kMeasures.size()> row = {e.joint_deg, e.wrist_deg, e.keypoint_mm, e.keypoint_px, e.camera_mm};
+      const std::array<double, kMeasures.size()> row = {e.joint_deg,   e.wrist_deg, e.keypoint_mm,
+                                                        e.keypoint_px, e.camera_mm, e.pa_mpjpe_mm};
       for (size_t m = 0; m < row.size(); ++m) values[m].push_back(row[m]);
     }
     summary.frames.push_back(e);
@@ -129,6 +147,22 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
   for (const std::vector<double>& v : values) {
     summary.mean.push_back(Mean(v));
     summary.median.push_back(Median(v));
+  }
+  summary.within_20mm = FractionWithin(distances, 0.02);
+  summary.auc_0_50 = AreaUnderCurve(distances, 0.05);
+  // Jitter over each run of consecutive detected frames, weighted by its second differences.
+  double jitter = 0.0, truth_jitter = 0.0, weight = 0.0;
+  for (size_t begin = 0, end = 0; begin < detected_frames.size(); begin = end) {
+    for (end = begin + 1; end < detected_frames.size() && detected_frames[end] == detected_frames[end - 1] + 1;) ++end;
+    if (end - begin < 3) continue;
+    const double n = static_cast<double>(end - begin - 2);
+    jitter += n * Jitter(std::span(estimated).subspan(begin, end - begin));
+    truth_jitter += n * Jitter(std::span(true_keypoints).subspan(begin, end - begin));
+    weight += n;
+  }
+  if (weight > 0.0) {
+    summary.jitter_mm = 1000.0 * jitter / weight;
+    summary.truth_jitter_mm = 1000.0 * truth_jitter / weight;
   }
   return summary;
 }
@@ -148,10 +182,18 @@ nlohmann::json ToJson(const PoseErrorSummary& summary) {
       f["keypoint_mm"] = e.keypoint_mm;
       f["keypoint_px"] = e.keypoint_px;
       f["camera_mm"] = e.camera_mm;
+      f["pa_mpjpe_mm"] = e.pa_mpjpe_mm;
     }
     frames.push_back(f);
   }
-  return {{"frames", summary.frames.size()}, {"detected", summary.detected}, {"mean", mean}, {"median", median},
+  return {{"frames", summary.frames.size()},
+          {"detected", summary.detected},
+          {"mean", mean},
+          {"median", median},
+          {"within_20mm", summary.within_20mm},
+          {"auc_0_50", summary.auc_0_50},
+          {"jitter_mm", summary.jitter_mm},
+          {"truth_jitter_mm", summary.truth_jitter_mm},
           {"per_frame", frames}};
 }
 
@@ -164,6 +206,8 @@ std::string FormatTable(const PoseErrorSummary& summary) {
     out << std::left << std::setw(14) << kMeasures[m] << std::right << std::setw(10) << summary.mean[m] << std::setw(10)
         << summary.median[m] << "\n";
   }
+  out << "keypoints within 20 mm " << summary.within_20mm << ", AUC 0-50 mm " << summary.auc_0_50 << "\n";
+  out << "jitter " << summary.jitter_mm << " mm/frame^2 (the truth's own " << summary.truth_jitter_mm << ")\n";
   return out.str();
 }
 

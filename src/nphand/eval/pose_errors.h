@@ -1,7 +1,8 @@
 // Errors of estimated poses against ground truth, frame by frame: what `nphand estimate`
 // wrote (poses.jsonl) against what `nphand sequence` rendered (truth.jsonl), in the paper's
 // measures (joint angles; 3D joint positions about the wrist, which the paper prefers, Fig. 8)
-// and today's (wrist rotation, 2D keypoints in pixels, 3D keypoints in the camera frame).
+// and today's (wrist rotation, 2D keypoints in pixels, 3D keypoints in the camera frame,
+// PA-MPJPE, the fraction within 20 mm and the AUC over 0-50 mm, jitter; measures.h).
 #pragma once
 
 #include <filesystem>
@@ -21,14 +22,23 @@ struct FramePoseError {
   double keypoint_mm = 0.0;  // mean 3D keypoint distance about the wrist, estimate scaled to the truth's hand length
   double keypoint_px = 0.0;  // mean 2D keypoint distance in the frame
   double camera_mm = 0.0;    // mean 3D keypoint distance in the camera frame
+  double pa_mpjpe_mm = 0.0;  // keypoint_mm's keypoints after a similarity (Procrustes) alignment
 };
 
 struct PoseErrorSummary {
   std::vector<FramePoseError> frames;
   int detected = 0;
   // Over detected frames: mean and median of each measure, in the order joint_deg,
-  // wrist_deg, keypoint_mm, keypoint_px, camera_mm.
+  // wrist_deg, keypoint_mm, keypoint_px, camera_mm, pa_mpjpe_mm.
   std::vector<double> mean, median;
+  // Over every keypoint of the detected frames (about the wrist, as keypoint_mm): the
+  // fraction within 20 mm and the area under that fraction's curve over 0-50 mm.
+  double within_20mm = 0.0;
+  double auc_0_50 = 0.0;
+  // Mean keypoint acceleration about the wrist, mm per frame squared, over runs of three
+  // detected frames in a row: the estimate's and the truth's own over the same frames.
+  double jitter_mm = 0.0;
+  double truth_jitter_mm = 0.0;
 };
 
 // Reads both files (one JSON object per line, the same frames in the same order) and

@@ -1,0 +1,75 @@
+#include "nphand/eval/measures.h"
+
+#include <algorithm>
+
+#include <Eigen/Geometry>
+
+#include "nphand/util/check.h"
+
+namespace nphand {
+namespace {
+
+Eigen::Matrix3Xd Columns(const Keypoints3d& keypoints) {
+  Eigen::Matrix3Xd m(3, kNumKeypoints);
+  for (int k = 0; k < kNumKeypoints; ++k) m.col(k) = keypoints[k];
+  return m;
+}
+
+}  // namespace
+
+std::vector<double> RootRelativeDistances(const Keypoints3d& estimate, const Keypoints3d& truth) {
+  std::vector<double> distances(kNumKeypoints);
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    distances[k] = ((estimate[k] - estimate[0]) - (truth[k] - truth[0])).norm();
+  }
+  return distances;
+}
+
+double RootRelativeError(const Keypoints3d& estimate, const Keypoints3d& truth) {
+  const std::vector<double> d = RootRelativeDistances(estimate, truth);
+  double sum = 0.0;
+  for (double v : d) sum += v;
+  return sum / kNumKeypoints;
+}
+
+double ProcrustesError(const Keypoints3d& estimate, const Keypoints3d& truth) {
+  const Eigen::Matrix3Xd from = Columns(estimate), to = Columns(truth);
+  const Eigen::Matrix4d similarity = Eigen::umeyama(from, to, true);
+  const Eigen::Matrix3Xd aligned = (similarity.topLeftCorner<3, 3>() * from).colwise() + similarity.topRightCorner<3, 1>();
+  return (aligned - to).colwise().norm().mean();
+}
+
+double FractionWithin(std::span<const double> distances, double threshold) {
+  if (distances.empty()) return 0.0;
+  return static_cast<double>(std::count_if(distances.begin(), distances.end(), [&](double d) { return d <= threshold; })) /
+         static_cast<double>(distances.size());
+}
+
+double AreaUnderCurve(std::span<const double> distances, double max, int steps) {
+  NPHAND_THROW_CHECK(max > 0.0 && steps >= 1, "AUC: needs a positive range and at least one step");
+  std::vector<double> sorted(distances.begin(), distances.end());
+  std::sort(sorted.begin(), sorted.end());
+  auto within = [&](double t) {
+    if (sorted.empty()) return 0.0;
+    return static_cast<double>(std::upper_bound(sorted.begin(), sorted.end(), t) - sorted.begin()) /
+           static_cast<double>(sorted.size());
+  };
+  double area = 0.0, previous = within(0.0);
+  for (int s = 1; s <= steps; ++s) {
+    const double next = within(max * s / steps);
+    area += 0.5 * (previous + next) / steps;
+    previous = next;
+  }
+  return area;
+}
+
+double Jitter(std::span<const Keypoints3d> frames) {
+  if (frames.size() < 3) return 0.0;
+  double sum = 0.0;
+  for (size_t t = 1; t + 1 < frames.size(); ++t) {
+    for (int k = 0; k < kNumKeypoints; ++k) sum += (frames[t + 1][k] - 2.0 * frames[t][k] + frames[t - 1][k]).norm();
+  }
+  return sum / (static_cast<double>(frames.size() - 2) * kNumKeypoints);
+}
+
+}  // namespace nphand

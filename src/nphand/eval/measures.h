@@ -1,0 +1,39 @@
+// Today's hand-pose measures (HO-3D, DexYCB, FreiHAND), on the 21 keypoints in metres:
+// MPJPE about the root, PA-MPJPE after a similarity Procrustes alignment, the fraction of
+// keypoints within a distance and the area under that curve, and jitter. The paper's own
+// measures (pose-vector error, keypoints about the wrist) are in pose_errors.h.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "nphand/model/hand_model.h"
+
+namespace nphand {
+
+// Mean distance between corresponding keypoints once both sets are moved so that their
+// roots (keypoint 0, the wrist) meet: root-relative MPJPE, metres.
+double RootRelativeError(const Keypoints3d& estimate, const Keypoints3d& truth);
+
+// Mean distance between corresponding keypoints after the estimate is aligned to the truth
+// by the rotation, uniform scale and translation that minimise the squared distances
+// (Umeyama): PA-MPJPE, metres.
+double ProcrustesError(const Keypoints3d& estimate, const Keypoints3d& truth);
+
+// The distances of corresponding keypoints (root-relative, as RootRelativeError), metres.
+std::vector<double> RootRelativeDistances(const Keypoints3d& estimate, const Keypoints3d& truth);
+
+// The fraction of `distances` at most `threshold`.
+double FractionWithin(std::span<const double> distances, double threshold);
+
+// The area under the curve of FractionWithin over thresholds evenly spaced in [0, max]
+// (`steps` + 1 of them, trapezoids), divided by max: 1 when every distance is 0, 0 when
+// none is within max. FreiHAND's AUC over 0–50 mm is AreaUnderCurve(d, 0.05).
+double AreaUnderCurve(std::span<const double> distances, double max, int steps = 100);
+
+// Mean over frames and keypoints of the second difference |k(t+1) - 2 k(t) + k(t-1)|:
+// acceleration in metres per frame squared (0 for fewer than 3 frames). Compare an
+// estimate's with its ground truth's own.
+double Jitter(std::span<const Keypoints3d> frames);
+
+}  // namespace nphand

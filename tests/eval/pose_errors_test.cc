@@ -1,0 +1,102 @@
+// Errors of poses against the truth, on lines written here: an exact copy has no error,
+// every keypoint within 20 mm and an AUC of 1; a turned copy keeps no error after the
+// Procrustes alignment; jitter is measured over runs of detected frames only.
+#include "nphand/eval/pose_errors.h"
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "nphand/util/random.h"
+#include "testing/testing.h"
+
+namespace nphand {
+namespace {
+
+// A line of poses.jsonl / truth.jsonl for `frame` with hand keypoints `hand` (metres).
+nlohmann::json Line(int frame, bool detected, const std::vector<Eigen::Vector3d>& hand) {
+  nlohmann::json line = {{"frame", frame}, {"detected", detected}};
+  if (!detected) return line;
+  nlohmann::json h = nlohmann::json::array(), c = nlohmann::json::array(), p = nlohmann::json::array();
+  for (const Eigen::Vector3d& k : hand) {
+    h.push_back({k.x(), k.y(), k.z()});
+    c.push_back({k.x(), k.y(), k.z() + 0.5});
+    p.push_back({320.0 + 1000.0 * k.x(), 240.0 + 1000.0 * k.y()});
+  }
+  line["keypoints_3d_hand_m"] = h;
+  line["keypoints_3d_camera_m"] = c;
+  line["keypoints_2d_px"] = p;
+  line["joint_angles_deg"] = {{"index_pip_flex", 30.0}, {"thumb_ip_flex", 10.0}};
+  line["wrist_rotation"] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+  return line;
+}
+
+std::filesystem::path Write(const std::filesystem::path& path, const std::vector<nlohmann::json>& lines) {
+  std::ofstream out(path);
+  for (const nlohmann::json& line : lines) out << line.dump() << "\n";
+  return path;
+}
+
+class PoseErrorsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    Random random(testing::kTestSeed);
+    for (int f = 0; f < 8; ++f) {
+      std::vector<Eigen::Vector3d> hand(kNumKeypoints, Eigen::Vector3d::Zero());
+      for (int k = 1; k < kNumKeypoints; ++k) {
+        hand[k] = Eigen::Vector3d(random.Uniform(-0.09, 0.09), random.Uniform(-0.09, 0.09), random.Uniform(-0.03, 0.03));
+      }
+      hands_.push_back(hand);
+    }
+  }
+  std::vector<std::vector<Eigen::Vector3d>> hands_;  // per frame, the wrist at the origin
+};
+
+TEST_F(PoseErrorsTest, AnExactCopyHasNoErrorAndATurnedOneNoneAfterAlignment) {
+  const auto dir = testing::ScratchDir();
+  std::vector<nlohmann::json> truth, turned;
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (int f = 0; f < 8; ++f) {
+    truth.push_back(Line(f, true, hands_[f]));
+    std::vector<Eigen::Vector3d> t = hands_[f];
+    for (Eigen::Vector3d& k : t) k = turn * k;
+    turned.push_back(Line(f, true, t));
+  }
+  const PoseErrorSummary same = ComparePoses(Write(dir / "truth.jsonl", truth), dir / "truth.jsonl");
+  EXPECT_EQ(same.detected, 8);
+  for (double v : same.mean) EXPECT_NEAR(v, 0.0, 1e-9);
+  EXPECT_DOUBLE_EQ(same.within_20mm, 1.0);
+  EXPECT_DOUBLE_EQ(same.auc_0_50, 1.0);
+  EXPECT_NEAR(same.jitter_mm, same.truth_jitter_mm, 1e-9);
+  EXPECT_GT(same.truth_jitter_mm, 0.0);
+
+  const PoseErrorSummary other = ComparePoses(dir / "truth.jsonl", Write(dir / "turned.jsonl", turned));
+  EXPECT_GT(other.mean[2], 5.0) << "keypoint_mm sees the turn";
+  EXPECT_NEAR(other.mean[5], 0.0, 1e-6) << "pa_mpjpe_mm does not";
+  EXPECT_LT(other.within_20mm, 1.0);
+  EXPECT_LT(other.auc_0_50, 1.0);
+  const nlohmann::json json = ToJson(other);
+  EXPECT_TRUE(json["mean"].contains("pa_mpjpe_mm"));
+  EXPECT_TRUE(json.contains("auc_0_50"));
+  EXPECT_TRUE(json["per_frame"][0].contains("pa_mpjpe_mm"));
+  EXPECT_NE(FormatTable(other).find("AUC 0-50 mm"), std::string::npos);
+}
+
+TEST_F(PoseErrorsTest, JitterSkipsTheGapsOfUndetectedFrames) {
+  const auto dir = testing::ScratchDir();
+  std::vector<nlohmann::json> truth, poses;
+  for (int f = 0; f < 8; ++f) {
+    truth.push_back(Line(f, true, hands_[0]));  // a still hand
+    // Detected on 0-2 and 5-7; on frames 3 and 4 "no hand". A still estimate on each run,
+    // the two runs far apart: no jitter unless a window spans the gap.
+    std::vector<Eigen::Vector3d> moved = hands_[f < 4 ? 0 : 1];
+    poses.push_back(Line(f, f < 3 || f > 4, moved));
+  }
+  const PoseErrorSummary s = ComparePoses(Write(dir / "truth.jsonl", truth), Write(dir / "poses.jsonl", poses));
+  EXPECT_EQ(s.detected, 6);
+  EXPECT_NEAR(s.jitter_mm, 0.0, 1e-9);
+  EXPECT_NEAR(s.truth_jitter_mm, 0.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace nphand
