@@ -52,6 +52,10 @@ TEST(MeasuresTest, FractionsAndTheirAreaFollowTheDistances) {
   for (int i = 0; i < 1000; ++i) even.push_back(0.05 * (i + 0.5) / 1000.0);
   EXPECT_NEAR(AreaUnderCurve(even, 0.05), 0.5, 0.01);
   testing::ExpectError([&] { AreaUnderCurve(d, 0.0); }, "positive range");
+  // A distance that is not a number counts as never within.
+  const std::vector<double> with_nan = {0.0, std::nan("")};
+  EXPECT_DOUBLE_EQ(FractionWithin(with_nan, 1.0), 0.5);
+  EXPECT_DOUBLE_EQ(AreaUnderCurve(with_nan, 0.05), 0.5);
 }
 
 TEST(MeasuresTest, JitterIsTheMeanSecondDifference) {

@@ -1,6 +1,8 @@
 #include "nphand/eval/measures.h"
 
 #include <algorithm>
+#include <cmath>
+#include <iterator>
 
 #include <Eigen/Geometry>
 
@@ -47,12 +49,14 @@ double FractionWithin(std::span<const double> distances, double threshold) {
 
 double AreaUnderCurve(std::span<const double> distances, double max, int steps) {
   NPHAND_THROW_CHECK(max > 0.0 && steps >= 1, "AUC: needs a positive range and at least one step");
-  std::vector<double> sorted(distances.begin(), distances.end());
+  // A distance that is not a number is never within (and must stay out of the sort).
+  std::vector<double> sorted;
+  std::copy_if(distances.begin(), distances.end(), std::back_inserter(sorted), [](double d) { return !std::isnan(d); });
   std::sort(sorted.begin(), sorted.end());
   auto within = [&](double t) {
-    if (sorted.empty()) return 0.0;
+    if (distances.empty()) return 0.0;
     return static_cast<double>(std::upper_bound(sorted.begin(), sorted.end(), t) - sorted.begin()) /
-           static_cast<double>(sorted.size());
+           static_cast<double>(distances.size());
   };
   double area = 0.0, previous = within(0.0);
   for (int s = 1; s <= steps; ++s) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <iomanip>
 #include <numbers>
@@ -153,7 +154,10 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
   // Jitter over each run of consecutive detected frames, weighted by its second differences.
   double jitter = 0.0, truth_jitter = 0.0, weight = 0.0;
   for (size_t begin = 0, end = 0; begin < detected_frames.size(); begin = end) {
-    for (end = begin + 1; end < detected_frames.size() && detected_frames[end] == detected_frames[end - 1] + 1;) ++end;
+    for (end = begin + 1; end < detected_frames.size() &&
+                          int64_t{detected_frames[end]} == int64_t{detected_frames[end - 1]} + 1;) {
+      ++end;
+    }
     if (end - begin < 3) continue;
     const double n = static_cast<double>(end - begin - 2);
     jitter += n * Jitter(std::span(estimated).subspan(begin, end - begin));
