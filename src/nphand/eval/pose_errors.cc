@@ -128,9 +128,12 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
       for (int k = 0; k < kNumKeypoints; ++k) {
         estimate[k] = scale * Eigen::Vector3d(kh[k][0], kh[k][1], kh[k][2]);
         truth_hand[k] = Eigen::Vector3d(th[k][0], th[k][1], th[k][2]);
-        const double d = (estimate[k] - truth_hand[k]).norm();
-        distances.push_back(d);
-        e.keypoint_mm += 1000.0 * d / kNumKeypoints;
+      }
+      // Both sets hold the wrist at the origin: root-relative distances are the plain ones.
+      const std::vector<double> d = RootRelativeDistances(estimate, truth_hand);
+      distances.insert(distances.end(), d.begin(), d.end());
+      e.keypoint_mm = 1000.0 * RootRelativeError(estimate, truth_hand);
+      for (int k = 0; k < kNumKeypoints; ++k) {
         e.camera_mm += 1000.0 * std::hypot(kc[k][0] - tc[k][0], kc[k][1] - tc[k][1], kc[k][2] - tc[k][2]) / kNumKeypoints;
         e.keypoint_px += std::hypot(k2[k][0] - t2[k][0], k2[k][1] - t2[k][1]) / kNumKeypoints;
       }

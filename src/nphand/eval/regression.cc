@@ -151,18 +151,19 @@ class Rvm : public PoseRegressor {
     Eigen::VectorXd alpha = Eigen::VectorXd::Constant(basis, 1.0);
     std::vector<Eigen::Index> active(basis);
     for (Eigen::Index i = 0; i < basis; ++i) active[i] = i;
-    // The posterior precision beta Phi_A^T Phi_A + diag(alpha_A) over the active basis
-    // functions, and Phi_A^T Y.
-    Eigen::MatrixXd precision, projected;
+    // Over the active basis functions: Phi_A^T Phi_A, Phi_A^T Y and the posterior precision
+    // beta Phi_A^T Phi_A + diag(alpha_A).
+    Eigen::MatrixXd sub_gram, projected, precision;
     auto restrict = [&]() {
       const Eigen::Index a = static_cast<Eigen::Index>(active.size());
-      precision.resize(a, a);
+      sub_gram.resize(a, a);
       projected.resize(a, y.cols());
       for (Eigen::Index r = 0; r < a; ++r) {
-        for (Eigen::Index c = 0; c < a; ++c) precision(r, c) = beta * gram(active[r], active[c]);
-        precision(r, r) += alpha[active[r]];
+        for (Eigen::Index c = 0; c < a; ++c) sub_gram(r, c) = gram(active[r], active[c]);
         projected.row(r) = phi_y.row(active[r]);
       }
+      precision = beta * sub_gram;
+      for (Eigen::Index r = 0; r < a; ++r) precision(r, r) += alpha[active[r]];
     };
     Eigen::MatrixXd mu;
     for (summary_.iterations = 0; summary_.iterations < options_.iterations;) {
@@ -174,10 +175,6 @@ class Rvm : public PoseRegressor {
       const Eigen::MatrixXd sigma = llt.solve(Eigen::MatrixXd::Identity(a, a));
       mu = beta * sigma * projected;
       // ||Y - Phi mu||^2 from the Gram matrix: tr(Y^T Y) - 2 tr(mu^T Phi^T Y) + tr(mu^T G mu).
-      Eigen::MatrixXd sub_gram(a, a);
-      for (Eigen::Index r = 0; r < a; ++r) {
-        for (Eigen::Index c = 0; c < a; ++c) sub_gram(r, c) = gram(active[r], active[c]);
-      }
       const double residual =
           std::max(0.0, y_squares - 2.0 * (mu.array() * projected.array()).sum() + (mu.transpose() * sub_gram * mu).trace());
       double well_determined = 0.0, largest_step = 0.0;
