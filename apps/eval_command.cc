@@ -1,11 +1,13 @@
 #include "apps/eval_command.h"
 
+#include <chrono>
 #include <iostream>
 
 #include "nphand/render/draw.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
 #include "nphand/util/io.h"
+#include "nphand/util/system.h"
 
 namespace nphand {
 
@@ -78,6 +80,94 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
     WriteFileAtomic(options.out_dir / (options.name + ".json"), json.dump(2) + "\n");
   }
   return scores;
+}
+
+namespace {
+
+void WritePoseStudy(const PoseStudyResult& result, const std::filesystem::path& out_dir) {
+  WriteFileAtomic(out_dir / (result.part + ".json"), ToJson(result).dump(2) + "\n");
+  for (const auto& [stem, image] : PlotPoseStudy(result)) WriteImageAtomic(out_dir / (stem + ".png"), image);
+}
+
+std::filesystem::path IndexPath(const EvalPoseStudyCommandOptions& options) {
+  return options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+}
+
+// What a pose study reads, opened in place (the index refers to the database).
+struct LoadedStudy {
+  LoadedStudy(const EvalPoseStudyCommandOptions& options, const std::string& command)
+      : db(Open(options, command)), index(LoadIndex(IndexPath(options), db)),
+        hand(HandModel::Load(Handedness::kRight, options.asset_dir)) {}
+  static Database Open(const EvalPoseStudyCommandOptions& options, const std::string& command) {
+    std::string why;
+    NPHAND_THROW_CHECK(options.study.Check(&why), command, ": ", why);
+    if (!options.out_dir.empty()) CheckOutputFolder(options.out_dir, command + " --out");
+    return Database::Open(options.db);
+  }
+  Database db;
+  std::unique_ptr<KnnIndex> index;
+  HandModel hand;
+};
+
+}  // namespace
+
+PoseStudyResult RunEvalPoseStudy(PoseStudyPart part, const EvalPoseStudyCommandOptions& options) {
+  const LoadedStudy loaded(options, "eval " + ToString(part));
+  PoseStudyResult result = RunPoseStudy(part == PoseStudyPart::kBaselines ? PoseStudyPart::kNoise : part, loaded.db,
+                                        *loaded.index, loaded.hand, EstimatorOptions{},
+                                        [&] {
+                                          PoseStudyOptions o = options.study;
+                                          if (part == PoseStudyPart::kBaselines) o.alphas = {0.0};
+                                          return o;
+                                        }(),
+                                        &std::cerr);
+  if (part == PoseStudyPart::kBaselines) result = BaselinesOf(result);
+  if (!options.out_dir.empty()) WritePoseStudy(result, options.out_dir);
+  return result;
+}
+
+nlohmann::json RunEvalAll(const EvalPoseStudyCommandOptions& options) {
+  NPHAND_THROW_CHECK(!options.out_dir.empty(), "eval all: --out is required (the study writes its files there)");
+  using Clock = std::chrono::steady_clock;
+  nlohmann::json summary = {{"machine", MachineDescription()}, {"parts", nlohmann::json::object()}};
+  const auto timed = [&](const std::string& name, const auto& run) {
+    const Clock::time_point start = Clock::now();
+    run();
+    summary["parts"][name] = std::chrono::duration<double>(Clock::now() - start).count();
+    std::cerr << "eval all: " << name << " done\n";
+  };
+  timed("features", [&] {
+    EvalFeaturesCommandOptions features;
+    features.db = options.db;
+    features.out_dir = options.out_dir;
+    RunEvalFeatures(features);
+  });
+  timed("ann", [&] {
+    EvalAnnCommandOptions ann;
+    ann.db = options.db;
+    ann.asset_dir = options.asset_dir;
+    ann.out_dir = options.out_dir;
+    ann.study.fractions = {1.0};
+    ann.study.configs = {"exact", "lsh", "hnswlib-sq8", "faiss-ivf"};
+    RunEvalAnn(ann);
+  });
+  const LoadedStudy loaded(options, "eval all");
+  timed("noise and baselines", [&] {
+    const PoseStudyResult noise =
+        RunPoseStudy(PoseStudyPart::kNoise, loaded.db, *loaded.index, loaded.hand, EstimatorOptions{}, options.study, &std::cerr);
+    WritePoseStudy(noise, options.out_dir);
+    WritePoseStudy(BaselinesOf(noise), options.out_dir);
+  });
+  timed("robustness", [&] {
+    WritePoseStudy(RunPoseStudy(PoseStudyPart::kRobustness, loaded.db, *loaded.index, loaded.hand, EstimatorOptions{},
+                                options.study, &std::cerr),
+                   options.out_dir);
+  });
+  double total = 0.0;
+  for (const auto& [name, seconds] : summary["parts"].items()) total += seconds.get<double>();
+  summary["seconds"] = total;
+  WriteFileAtomic(options.out_dir / "evaluation.json", summary.dump(2) + "\n");
+  return summary;
 }
 
 }  // namespace nphand

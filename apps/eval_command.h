@@ -6,6 +6,7 @@
 #include "nphand/eval/ann_study.h"
 #include "nphand/eval/estimator_study.h"
 #include "nphand/eval/pose_errors.h"
+#include "nphand/eval/pose_study.h"
 #include "nphand/eval/feature_study.h"
 
 namespace nphand {
@@ -49,6 +50,23 @@ struct EvalPosesCommandOptions {
 
 // Errors of estimated poses against ground truth (docs/FORMAT.md), frame by frame.
 PoseErrorSummary RunEvalPoses(const EvalPosesCommandOptions& options);
+
+struct EvalPoseStudyCommandOptions {
+  std::filesystem::path db = "out/nphand.db";
+  std::filesystem::path index;  // default: the database's path + ".idx"
+  std::filesystem::path asset_dir = DefaultAssetDir();
+  std::filesystem::path out_dir;  // if set: <part>.json and its plots there
+  PoseStudyOptions study;
+};
+
+// `nphand eval baselines|noise|robustness` (docs/EVALUATION.md).
+PoseStudyResult RunEvalPoseStudy(PoseStudyPart part, const EvalPoseStudyCommandOptions& options);
+
+// `nphand eval all`: the feature study, the nearest-neighbour study at the database's full
+// size (exact, lsh, hnswlib-sq8, faiss-ivf), the noise study (whose alpha-0 rows are the
+// baselines) and the robustness study, each written to out_dir as its own command would,
+// and evaluation.json: what ran, how long each part took, on what machine.
+nlohmann::json RunEvalAll(const EvalPoseStudyCommandOptions& options);
 
 // The estimator's validation sweep (docs/estimator.md).
 std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& options);

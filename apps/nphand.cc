@@ -347,13 +347,65 @@ void AddEvalPosesCommand(CLI::App* eval, nphand::EvalPosesCommandOptions& o, boo
   });
 }
 
+void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOptions& o, bool& json) {
+  const auto add = [&](const char* name, const char* help) {
+    CLI::App* cmd = eval->add_subcommand(name, help);
+    nphand::PoseStudyOptions& s = o.study;
+    cmd->add_option("--db", o.db, "Database file")->capture_default_str();
+    cmd->add_option("--index", o.index, "Index file (default: the database's path + .idx)");
+    cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+    cmd->add_option("--out", o.out_dir, "Folder for the JSON and the plots");
+    cmd->add_option("--frames", s.frames, "Frames per test sequence")->capture_default_str();
+    cmd->add_option("--width", s.width, "Frame width")->capture_default_str();
+    cmd->add_option("--height", s.height, "Frame height")->capture_default_str();
+    cmd->add_option("--seed", s.seed, "Test sequences use seed..seed+4, the robustness variants seed+100")
+        ->capture_default_str();
+    cmd->add_option("--alphas", s.alphas, "Segmentation noise levels, % of hand pixels removed (noise)")
+        ->delimiter(',')
+        ->capture_default_str();
+    cmd->add_flag("!--no-exact", s.exact, "Skip the estimator with exact search (the slowest method)");
+    cmd->add_option("--lsq-rows", s.lsq_rows, "Database entries LSQ is fitted on")->capture_default_str();
+    cmd->add_option("--gp-rows", s.gp_rows, "Database entries GP is fitted on")->capture_default_str();
+    cmd->add_option("--rvm-rows", s.rvm_rows, "Database entries the RVM starts from")->capture_default_str();
+    cmd->add_option("--fit-seed", s.fit_seed, "Seed of the regressions' entries")->capture_default_str();
+    cmd->add_flag("--json", json, "Print one JSON object instead of the tables");
+    return cmd;
+  };
+  const auto print = [&json](const nphand::PoseStudyResult& r) {
+    if (json) {
+      std::cout << nphand::ToJson(r).dump() << "\n";
+      return;
+    }
+    for (const nlohmann::json& sequence : r.sequences) {
+      const std::string name = sequence["name"].get<std::string>();
+      if (r.part != "robustness" && r.part != "baselines") break;
+      std::cout << "# " << name << "\n" << nphand::FormatScores(r.scores, name) << "\n";
+    }
+    if (r.part != "robustness") std::cout << "# all sequences\n" << nphand::FormatScores(r.scores) << "\n";
+    std::cout << "took " << static_cast<int>(r.seconds) << " s\n";
+  };
+  using Part = nphand::PoseStudyPart;
+  add("baselines", "Every method of the paper's comparison on the test sequences (Fig. 6), clean masks")
+      ->callback([&o, print]() { print(nphand::RunEvalPoseStudy(Part::kBaselines, o)); });
+  add("noise", "The mask methods under segmentation noise (Fig. 7): alpha % of hand pixels removed, then eroded and dilated")
+      ->callback([&o, print]() { print(nphand::RunEvalPoseStudy(Part::kNoise, o)); });
+  add("robustness", "The estimator on variants of one sequence: skin tone, background, sleeve, hand proportions")
+      ->callback([&o, print]() { print(nphand::RunEvalPoseStudy(Part::kRobustness, o)); });
+  add("all", "The whole study: features, ann, baselines, noise, robustness (needs --out)")->callback([&o, &json]() {
+    const nlohmann::json summary = nphand::RunEvalAll(o);
+    std::cout << (json ? summary.dump() : summary.dump(2)) << "\n";
+  });
+}
+
 void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, nphand::EvalAnnCommandOptions& ann,
-                    nphand::EvalEstimatorCommandOptions& estimator, nphand::EvalPosesCommandOptions& poses, bool& json) {
+                    nphand::EvalEstimatorCommandOptions& estimator, nphand::EvalPosesCommandOptions& poses,
+                    nphand::EvalPoseStudyCommandOptions& study, bool& json) {
   CLI::App* eval = app.add_subcommand("eval", "The paper's experiments");
   eval->require_subcommand(1);
   AddEvalPosesCommand(eval, poses, json);
   AddEvalAnnCommand(eval, ann, json);
   AddEvalEstimatorCommand(eval, estimator, json);
+  AddEvalPoseStudyCommands(eval, study, json);
   CLI::App* features = eval->add_subcommand("features", "Feature study (paper Fig. 4): pose error of feature-space neighbours");
   nphand::FeatureStudyOptions& s = o.study;
   features->add_option("--db", o.db, "Database file")->capture_default_str();
@@ -423,7 +475,8 @@ int main(int argc, char** argv) {
   nphand::EvalAnnCommandOptions ann_options;
   nphand::EvalEstimatorCommandOptions estimator_study_options;
   nphand::EvalPosesCommandOptions poses_options;
-  AddEvalCommand(app, eval_options, ann_options, estimator_study_options, poses_options, json);
+  nphand::EvalPoseStudyCommandOptions pose_study_options;
+  AddEvalCommand(app, eval_options, ann_options, estimator_study_options, poses_options, pose_study_options, json);
   try {
     CheckSubcommands(app, argc, argv);
     app.parse(argc, argv);

@@ -40,7 +40,7 @@ TEST(RegressionTest, LeastSquaresRecoversALinearMap) {
   lsq->Fit(x, affine(x));
   const Eigen::MatrixXd test = RandomMatrix(50, 10, random);
   EXPECT_LT(Rms(lsq->Predict(test), affine(test)), 1e-9);
-  EXPECT_EQ(lsq->Name(), "lsq");
+  EXPECT_EQ(lsq->Name(), "LSQ");
 }
 
 TEST(RegressionTest, GaussianProcessInterpolatesAndChoosesItsScaleByTheEvidence) {

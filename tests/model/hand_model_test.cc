@@ -1,5 +1,6 @@
 #include "nphand/model/hand_model.h"
 
+#include <cmath>
 #include <map>
 
 #include <Eigen/Geometry>
@@ -80,6 +81,31 @@ TEST(HandModelTest, BoneLengthsSurviveAnyPose) {
       ASSERT_NEAR((posed[j] - posed[p]).norm(), (bind[j] - bind[p]).norm(), 1e-12) << JointName(static_cast<Joint>(j));
     }
   }
+}
+
+TEST(HandModelTest, ReproportionedHandIsLongerAndNarrowerAndStillRigged) {
+  const HandModel& hand = RightHand();
+  const HandModel other = hand.Reproportioned(1.1, 0.9);
+  HandPose rest;
+  const Keypoints3d a = hand.KeypointsOf(rest), b = other.KeypointsOf(rest);
+  // The middle finger lies along the hand's length axis in the bind pose.
+  EXPECT_NEAR(HandLength(b) / HandLength(a), 1.1, 0.01);
+  const auto across = [](const Keypoints3d& k) { return (k[5] - k[17]).norm(); };  // index MCP to little MCP
+  EXPECT_NEAR(across(b) / across(a), 0.9, 0.02);
+  // Its rest pose is its bind pose, and its bones keep their lengths in any pose.
+  std::vector<Eigen::Vector3f> vertices;
+  other.Skin(rest, &vertices, nullptr);
+  for (size_t v = 0; v < vertices.size(); ++v) ASSERT_LT((vertices[v] - other.bind_vertices()[v]).norm(), 1e-6f);
+  Random random(testing::kTestSeed);
+  const JointPositions& bind = other.bind_joint_positions();
+  for (int trial = 0; trial < 20; ++trial) {
+    const JointPositions posed = other.JointPositionsOf(RandomPose(random, Handedness::kRight));
+    for (int j = 1; j < kNumJoints; ++j) {
+      ASSERT_NEAR((posed[j] - posed[JointParent(j)]).norm(), (bind[j] - bind[JointParent(j)]).norm(), 1e-12);
+    }
+  }
+  EXPECT_THROW(hand.Reproportioned(0.1, 1.0), Error);
+  EXPECT_THROW(hand.Reproportioned(1.0, std::nan("")), Error);
 }
 
 TEST(HandModelTest, KeypointsMoveWithTheirJointsOnly) {

@@ -46,7 +46,7 @@ Eigen::MatrixXd Kernel(const Eigen::MatrixXd& squared_distances, double length_s
 class LinearRegressor : public PoseRegressor {
  public:
   explicit LinearRegressor(const LinearOptions& options) : options_(options) {}
-  std::string Name() const override { return "lsq"; }
+  std::string Name() const override { return "LSQ"; }
 
   void Fit(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override {
     CheckTraining(Name(), x, y, 2);
@@ -74,7 +74,7 @@ class LinearRegressor : public PoseRegressor {
 class GaussianProcess : public PoseRegressor {
  public:
   explicit GaussianProcess(const GaussianProcessOptions& options) : options_(options) {}
-  std::string Name() const override { return "gp"; }
+  std::string Name() const override { return "GP"; }
 
   void Fit(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override {
     CheckTraining(Name(), x, y, 2);
@@ -132,7 +132,7 @@ class GaussianProcess : public PoseRegressor {
 class Rvm : public PoseRegressor {
  public:
   explicit Rvm(const RvmOptions& options) : options_(options) {}
-  std::string Name() const override { return "rvm"; }
+  std::string Name() const override { return "RVM"; }
 
   void Fit(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) override {
     CheckTraining(Name(), x, y, 2);

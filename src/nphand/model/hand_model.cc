@@ -1,5 +1,6 @@
 #include "nphand/model/hand_model.h"
 
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 
@@ -140,27 +141,7 @@ HandModel HandModel::FromGlb(std::span<const uint8_t> glb, Handedness handedness
   model.handedness_ = handedness;
   for (int j = 0; j < kNumJoints; ++j) model.bind_positions_[j] = hand_from_mesh * mesh_joints[j];
 
-  // Anatomical joint frames: x along the bone to the child, z towards the back of the hand
-  // (for the thumb: towards its nail, between the back of the hand and the radial side).
-  const Eigen::Vector3d dorsal = Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d ulnar =
-      (model.bind_positions_[Index(Joint::kLittleProximal)] - model.bind_positions_[Index(Joint::kIndexProximal)])
-          .normalized();
-  model.bind_axes_[0] = Eigen::Matrix3d::Identity();
-  for (int j = 1; j < kNumJoints; ++j) {
-    if (IsTip(j)) {
-      model.bind_axes_[j] = model.bind_axes_[j - 1];
-      continue;
-    }
-    const Eigen::Vector3d up = IsThumb(j) ? (dorsal - ulnar).normalized() : dorsal;
-    model.bind_axes_[j] = FrameFromBone(model.bind_positions_[j + 1] - model.bind_positions_[j], up);
-  }
-  for (int j = 0; j < kNumJoints; ++j) {
-    const Eigen::Isometry3d hand_from_joint = MakeFrame(model.bind_axes_[j], model.bind_positions_[j]);
-    model.joint_from_hand_[j] = hand_from_joint.inverse();
-    const int parent = JointParent(j);
-    model.parent_from_joint_[j] = parent < 0 ? hand_from_joint : model.joint_from_hand_[parent] * hand_from_joint;
-  }
+  model.SetJointFrames();
 
   // The skinned mesh: its one triangle primitive.
   const tinygltf::Primitive* primitive = nullptr;
@@ -237,6 +218,43 @@ HandModel HandModel::FromGlb(std::span<const uint8_t> glb, Handedness handedness
       model.triangles_[t][k] = static_cast<int>(indices[3 * t + k]);
     }
   }
+  return model;
+}
+
+void HandModel::SetJointFrames() {
+  // Anatomical joint frames: x along the bone to the child, z towards the back of the hand
+  // (for the thumb: towards its nail, between the back of the hand and the radial side).
+  const Eigen::Vector3d dorsal = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d ulnar =
+      (bind_positions_[Index(Joint::kLittleProximal)] - bind_positions_[Index(Joint::kIndexProximal)]).normalized();
+  bind_axes_[0] = Eigen::Matrix3d::Identity();
+  for (int j = 1; j < kNumJoints; ++j) {
+    if (IsTip(j)) {
+      bind_axes_[j] = bind_axes_[j - 1];
+      continue;
+    }
+    const Eigen::Vector3d up = IsThumb(j) ? (dorsal - ulnar).normalized() : dorsal;
+    bind_axes_[j] = FrameFromBone(bind_positions_[j + 1] - bind_positions_[j], up);
+  }
+  for (int j = 0; j < kNumJoints; ++j) {
+    const Eigen::Isometry3d hand_from_joint = MakeFrame(bind_axes_[j], bind_positions_[j]);
+    joint_from_hand_[j] = hand_from_joint.inverse();
+    const int parent = JointParent(j);
+    parent_from_joint_[j] = parent < 0 ? hand_from_joint : joint_from_hand_[parent] * hand_from_joint;
+  }
+}
+
+HandModel HandModel::Reproportioned(double length, double width) const {
+  NPHAND_THROW_CHECK(std::isfinite(length) && std::isfinite(width) && length >= 0.5 && length <= 2.0 && width >= 0.5 &&
+                         width <= 2.0,
+                     "hand proportions: length and width factors must be within [0.5, 2]");
+  HandModel model = *this;
+  const Eigen::Vector3d scale(length, width, width);
+  for (Eigen::Vector3d& p : model.bind_positions_) p = p.cwiseProduct(scale);
+  for (Eigen::Vector3f& v : model.bind_vertices_) v = v.cwiseProduct(scale.cast<float>());
+  // Normals transform by the inverse transpose of the scaling.
+  for (Eigen::Vector3f& n : model.bind_normals_) n = n.cwiseQuotient(scale.cast<float>()).normalized();
+  model.SetJointFrames();
   return model;
 }
 

@@ -45,6 +45,12 @@ class HandModel {
   // Parses a binary glTF already in memory (no hash check); `source` names it in errors.
   static HandModel FromGlb(std::span<const uint8_t> glb, Handedness handedness, const std::string& source);
 
+  // The same hand with other proportions: the bind pose (mesh and joints) stretched about
+  // the wrist by `length` along the hand (wrist towards the middle finger) and by `width`
+  // across and through it, the joint frames made afresh. For hands unlike the database's:
+  // bones ~10 % longer and narrower. Throws nphand::Error for factors outside [0.5, 2].
+  HandModel Reproportioned(double length, double width) const;
+
   Handedness handedness() const { return handedness_; }
   // The mesh in its bind pose, in the hand frame (metres).
   const std::vector<Eigen::Vector3f>& bind_vertices() const { return bind_vertices_; }
@@ -76,6 +82,8 @@ class HandModel {
  private:
   HandModel() = default;
   void CheckHandedness(const HandPose& pose) const;
+  // The joints' anatomical frames and the bind transforms, from bind_positions_.
+  void SetJointFrames();
 
   Handedness handedness_ = Handedness::kRight;
   std::vector<Eigen::Vector3f> bind_vertices_;

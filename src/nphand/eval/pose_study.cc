@@ -1,0 +1,747 @@
+#include "nphand/eval/pose_study.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
+
+#include "nphand/eval/measures.h"
+#include "nphand/eval/plot.h"
+#include "nphand/features/crop.h"
+#include "nphand/features/descriptor.h"
+#include "nphand/index/exact_index.h"
+#include "nphand/render/renderer.h"
+#include "nphand/util/check.h"
+#include "nphand/util/progress.h"
+#include "nphand/util/random.h"
+
+namespace nphand {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+Eigen::Matrix3d RotationOf(const PoseVector& x) {
+  Eigen::Matrix3d r;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = x[3 * i + j];
+  }
+  return r;
+}
+
+void SetRotation(const Eigen::Matrix3d& r, PoseVector* x) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) (*x)[3 * i + j] = r(i, j);
+  }
+}
+
+// What the mask-reading methods take from a mask: the crop and descriptor the database
+// would have made, and the rotation from the camera's axis to the ray through the hand.
+struct MaskView {
+  HandCrop crop;
+  Descriptor descriptor;
+  Eigen::Matrix3d towards_ray;
+};
+
+std::optional<MaskView> ViewOf(const cv::Mat& mask, const DescriptorConfig& config, const Intrinsics& camera) {
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.area() == 0) return std::nullopt;
+  const cv::Rect roi = cv::Rect(box.x - 2, box.y - 2, box.width + 4, box.height + 4) & cv::Rect(0, 0, mask.cols, mask.rows);
+  const std::optional<HandCrop> crop = CropHand(mask(roi) != 0, config.Crop());
+  if (!crop) return std::nullopt;
+  MaskView view{*crop, DescribeCrop(*crop, config), Eigen::Matrix3d::Identity()};
+  const cv::Moments m = cv::moments(mask, true);
+  const Eigen::Vector3d ray =
+      Eigen::Vector3d((m.m10 / m.m00 + 0.5 - camera.cx) / camera.fx, (m.m01 / m.m00 + 0.5 - camera.cy) / camera.fy, 1.0)
+          .normalized();
+  view.towards_ray = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), ray).toRotationMatrix();
+  return view;
+}
+
+// A roll-normalised pose vector seen in the frame: turned by `roll` and towards the ray.
+HandPose PoseInFrame(const PoseVector& normalised, double roll, const Eigen::Matrix3d& towards_ray) {
+  HandPose pose = FromPoseVector(normalised, Handedness::kRight);
+  pose.camera_from_hand = towards_ray * AxisAngle(Eigen::Vector3d::UnitZ(), roll) * pose.camera_from_hand;
+  return pose;
+}
+
+// Every entry with a hand: its pose vector with the rotation roll-normalised
+// (Rz(-roll) R, the frame the descriptor was computed in).
+struct NormalisedPoses {
+  std::vector<entry_id_t> ids;
+  Eigen::MatrixXd x;  // kPoseVectorSize x ids.size()
+};
+
+NormalisedPoses NormalisedPosesOf(const Database& db) {
+  NormalisedPoses out;
+  out.ids = DatabaseHandIds(db);
+  out.x.resize(kPoseVectorSize, static_cast<Eigen::Index>(out.ids.size()));
+  size_t row = 0;
+  ScanRecords(db, [&](size_t i) {
+    if (row >= out.ids.size() || out.ids[row] != i) return;
+    PoseVector x = db.Pose(i);
+    SetRotation(AxisAngle(Eigen::Vector3d::UnitZ(), -db.Meta(i).roll) * RotationOf(x), &x);
+    out.x.col(static_cast<Eigen::Index>(row++)) = x;
+  });
+  NPHAND_CHECK(row == out.ids.size(), "database entries changed while read");
+  return out;
+}
+
+class EstimatorMethod : public PoseMethod {
+ public:
+  EstimatorMethod(std::string name, const Database& db, const KnnIndex& index, const HandModel& hand,
+                  const EstimatorOptions& options, bool from_rgb)
+      : name_(std::move(name)), estimator_(db, index, hand, options), from_rgb_(from_rgb), backend_(index.Backend()) {}
+  std::string Name() const override { return name_; }
+  bool FromRgb() const override { return from_rgb_; }
+  void Reset() override { estimator_.Reset(); }
+  MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) override {
+    const FrameResult r = from_rgb_ ? estimator_.Process(frame.truth.rgb, frame.truth.time_s)
+                                    : estimator_.ProcessMask(mask, frame.truth.time_s);
+    MethodEstimate out;
+    out.detected = r.detected();
+    if (out.detected) {
+      out.pose = r.pose;
+      out.keypoints_2d = r.keypoints_2d;
+    }
+    return out;
+  }
+  nlohmann::json Describe() const override {
+    const EstimatorOptions& o = estimator_.options();
+    return {{"index", backend_},         {"k", o.k},           {"observation", ToString(o.observation)},
+            {"sigma_y", o.sigma_y},      {"prior", ToString(o.prior)}, {"sigma_x", o.sigma_x},
+            {"carried", o.carried},      {"input", from_rgb_ ? "rgb" : "mask"}};
+  }
+
+ private:
+  std::string name_;
+  Estimator estimator_;
+  bool from_rgb_;
+  std::string backend_;
+};
+
+class NearestPoseMethod : public PoseMethod {
+ public:
+  explicit NearestPoseMethod(const Database& db) : config_(db.descriptor()), poses_(NormalisedPosesOf(db)) {}
+  std::string Name() const override { return "NN pose"; }
+  MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) override {
+    const std::optional<MaskView> view = ViewOf(mask, config_, frame.intrinsics);
+    if (!view) return {};
+    const PoseVector truth = ToPoseVector(frame.truth.pose);
+    // |A N - R| = |N - A^T R| for a rotation A: the truth is brought into each turn's
+    // normalised frame once, instead of every entry into the frame.
+    double best = std::numeric_limits<double>::infinity();
+    PoseVector best_x = PoseVector::Zero();
+    double best_roll = 0.0;
+    for (double roll : {view->crop.roll, view->crop.roll + std::numbers::pi}) {
+      PoseVector target = truth;
+      SetRotation((view->towards_ray * AxisAngle(Eigen::Vector3d::UnitZ(), roll)).transpose() * RotationOf(truth), &target);
+      Eigen::Index at = 0;
+      const double d = (poses_.x.colwise() - target).colwise().squaredNorm().minCoeff(&at);
+      if (d < best) {
+        best = d;
+        best_x = poses_.x.col(at);
+        best_roll = roll;
+      }
+    }
+    return {true, PoseInFrame(best_x, best_roll, view->towards_ray), std::nullopt};
+  }
+
+ private:
+  DescriptorConfig config_;
+  NormalisedPoses poses_;
+};
+
+class MeanPoseMethod : public PoseMethod {
+ public:
+  explicit MeanPoseMethod(const Database& db) : config_(db.descriptor()), mean_(NormalisedPosesOf(db).x.rowwise().mean()) {}
+  std::string Name() const override { return "mean pose"; }
+  MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) override {
+    const std::optional<MaskView> view = ViewOf(mask, config_, frame.intrinsics);
+    if (!view) return {};
+    return {true, PoseInFrame(mean_, view->crop.roll, view->towards_ray), std::nullopt};
+  }
+
+ private:
+  DescriptorConfig config_;
+  PoseVector mean_;
+};
+
+class RegressionMethod : public PoseMethod {
+ public:
+  RegressionMethod(const Database& db, std::unique_ptr<PoseRegressor> regressor, int rows, uint64_t seed,
+                   std::ostream* progress)
+      : config_(db.descriptor()), regressor_(std::move(regressor)) {
+    const NormalisedPoses poses = NormalisedPosesOf(db);
+    NPHAND_THROW_CHECK(rows >= 2 && static_cast<size_t>(rows) <= poses.ids.size(), regressor_->Name(),
+                       ": the fit needs 2..", poses.ids.size(), " rows, not ", rows);
+    // Rows drawn without replacement (a partial Fisher-Yates shuffle), then in file order.
+    std::vector<size_t> order(poses.ids.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    Random random(seed);
+    for (int i = 0; i < rows; ++i) std::swap(order[i], order[i + random.UniformIndex(order.size() - i)]);
+    order.resize(rows);
+    std::sort(order.begin(), order.end());
+    std::vector<entry_id_t> ids;
+    for (size_t r : order) ids.push_back(poses.ids[r]);
+    const int d = config_.Dimension();
+    Eigen::MatrixXd x(rows, d), y(rows, kPoseVectorSize);
+    ForEachRow(db, ids, [&](size_t row, std::span<const float> hog) {
+      for (int c = 0; c < d; ++c) x(static_cast<Eigen::Index>(row), c) = hog[c];
+    });
+    for (int r = 0; r < rows; ++r) y.row(r) = poses.x.col(static_cast<Eigen::Index>(order[r])).transpose();
+    const Clock::time_point start = Clock::now();
+    if (progress != nullptr) *progress << regressor_->Name() << ": fitting on " << rows << " entries\n";
+    regressor_->Fit(x, y);
+    fit_seconds_ = std::chrono::duration<double>(Clock::now() - start).count();
+    rows_ = rows;
+  }
+  std::string Name() const override { return regressor_->Name(); }
+  MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) override {
+    const std::optional<MaskView> view = ViewOf(mask, config_, frame.intrinsics);
+    if (!view) return {};
+    Eigen::MatrixXd x(1, config_.Dimension());
+    for (int c = 0; c < config_.Dimension(); ++c) x(0, c) = view->descriptor.values[c];
+    const PoseVector predicted = regressor_->Predict(x).row(0).transpose();
+    return {true, PoseInFrame(predicted, view->crop.roll, view->towards_ray), std::nullopt};
+  }
+  nlohmann::json Describe() const override {
+    const RegressorSummary s = regressor_->Summary();
+    return {{"rows", rows_},
+            {"fit_s", fit_seconds_},
+            {"length_scale", s.length_scale},
+            {"noise_sd", s.noise_sd},
+            {"log_marginal", s.log_marginal},
+            {"basis", s.basis},
+            {"iterations", s.iterations}};
+  }
+
+ private:
+  DescriptorConfig config_;
+  std::unique_ptr<PoseRegressor> regressor_;
+  int rows_ = 0;
+  double fit_seconds_ = 0.0;
+};
+
+// One method's per-frame figures, gathered before they are summed.
+struct FrameFigures {
+  bool detected = false;
+  double pose_error = 0.0, keypoint_mm = 0.0, pa_mpjpe_mm = 0.0, joint_deg = 0.0, wrist_deg = 0.0, keypoint_px = kNaN;
+  std::vector<double> distances;
+  Keypoints3d estimate{}, truth{};
+  double ms = 0.0;
+};
+
+MethodScore Summarise(const std::string& method, const std::string& sequence, double alpha,
+                      const std::vector<std::vector<FrameFigures>>& runs) {
+  MethodScore s;
+  s.method = method;
+  s.sequence = sequence;
+  s.alpha = alpha;
+  std::vector<double> ms;
+  double px = 0.0;
+  int px_frames = 0;
+  double jitter = 0.0, truth_jitter = 0.0;
+  int jitter_count = 0;
+  for (const std::vector<FrameFigures>& frames : runs) {
+    std::vector<Keypoints3d> run_estimate, run_truth;
+    auto close_run = [&]() {
+      if (run_estimate.size() >= 3) {
+        const int n = static_cast<int>(run_estimate.size()) - 2;
+        jitter += Jitter(run_estimate) * n;
+        truth_jitter += Jitter(run_truth) * n;
+        jitter_count += n;
+      }
+      run_estimate.clear();
+      run_truth.clear();
+    };
+    for (const FrameFigures& f : frames) {
+      ++s.frames;
+      ms.push_back(f.ms);
+      if (!f.detected) {
+        close_run();
+        continue;
+      }
+      ++s.detected;
+      s.pose_error += f.pose_error;
+      s.keypoint_mm += f.keypoint_mm;
+      s.pa_mpjpe_mm += f.pa_mpjpe_mm;
+      s.joint_deg += f.joint_deg;
+      s.wrist_deg += f.wrist_deg;
+      if (!std::isnan(f.keypoint_px)) {
+        px += f.keypoint_px;
+        ++px_frames;
+      }
+      s.distances.insert(s.distances.end(), f.distances.begin(), f.distances.end());
+      run_estimate.push_back(f.estimate);
+      run_truth.push_back(f.truth);
+    }
+    close_run();
+  }
+  if (s.detected > 0) {
+    for (double* v : {&s.pose_error, &s.keypoint_mm, &s.pa_mpjpe_mm, &s.joint_deg, &s.wrist_deg}) *v /= s.detected;
+  }
+  s.keypoint_px = px_frames > 0 ? px / px_frames : kNaN;
+  s.within_20mm = FractionWithin(s.distances, 0.020);
+  s.auc_0_50 = AreaUnderCurve(s.distances, 0.050);
+  s.jitter_mm = jitter_count > 0 ? 1000.0 * jitter / jitter_count : kNaN;
+  s.truth_jitter_mm = jitter_count > 0 ? 1000.0 * truth_jitter / jitter_count : kNaN;
+  s.ms_median = Median(ms);
+  return s;
+}
+
+nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+std::vector<StudySequence> TestSequences(int frames, int width, int height, uint64_t seed) {
+  struct Plan {
+    const char* name;
+    int grasp;
+    double object_scale;
+    ForearmKind forearm;
+    BackgroundKind background;
+    const char* skin;
+    bool face;
+  };
+  // Objects the database lacks: its sizes scaled by 0.8 or 1.25 (the database's spheres
+  // have radii 0.5-4 cm, none 3.2; its box for grasp 18 is 12 x 12 x 2.5 cm).
+  const std::vector<Plan> plans = {
+      {"box", 18, 1.25, ForearmKind::kBare, BackgroundKind::kTexture, "light", false},       // a 15 x 15 x 3 cm book
+      {"ball", 11, 0.8, ForearmKind::kBare, BackgroundKind::kClutter, "olive", false},        // a 6.4 cm ball
+      {"bottle", 1, 0.8, ForearmKind::kSleeved, BackgroundKind::kPlain, "brown", false},     // a 6.4 cm bottle
+      {"lid", 10, 1.25, ForearmKind::kBare, BackgroundKind::kTexture, "medium", true},       // a 12.5 cm lid, a face beside
+      {"pen", 20, 1.25, ForearmKind::kBare, BackgroundKind::kClutter, "dark", false}};       // a writing tripod on a pen
+  std::vector<StudySequence> out;
+  for (size_t i = 0; i < plans.size(); ++i) {
+    StudySequence s;
+    s.name = plans[i].name;
+    s.options.frames = frames;
+    s.options.width = width;
+    s.options.height = height;
+    s.options.grasp = plans[i].grasp;
+    s.options.object_scale = plans[i].object_scale;
+    s.options.forearm = plans[i].forearm;
+    s.options.background = plans[i].background;
+    s.options.skin = plans[i].skin;
+    s.options.face = plans[i].face;
+    s.options.seed = seed + i;
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::vector<StudySequence> RobustnessSequences(int frames, int width, int height, uint64_t seed) {
+  StudySequence base;
+  base.name = "base";
+  base.options.frames = frames;
+  base.options.width = width;
+  base.options.height = height;
+  base.options.grasp = 11;
+  base.options.object_scale = 0.8;
+  base.options.forearm = ForearmKind::kBare;
+  base.options.background = BackgroundKind::kPlain;
+  base.options.skin = "medium";
+  base.options.seed = seed;
+  std::vector<StudySequence> out = {base};
+  auto variant = [&](const char* name, auto change) {
+    StudySequence s = base;
+    s.name = name;
+    change(s);
+    out.push_back(s);
+  };
+  variant("skin dark", [](StudySequence& s) { s.options.skin = "dark"; });
+  variant("skin light", [](StudySequence& s) { s.options.skin = "light"; });
+  variant("textured background", [](StudySequence& s) { s.options.background = BackgroundKind::kTexture; });
+  variant("sleeve", [](StudySequence& s) { s.options.forearm = ForearmKind::kSleeved; });
+  variant("hand 10% longer, narrower", [](StudySequence& s) {
+    s.length = 1.1;
+    s.width = 0.9;
+  });
+  return out;
+}
+
+std::vector<RenderedSequence> RenderSequences(const HandModel& hand, const std::vector<StudySequence>& sequences,
+                                              std::ostream* progress) {
+  uint64_t total = 0;
+  for (const StudySequence& s : sequences) total += static_cast<uint64_t>(s.options.frames);
+  ProgressLine line(progress, "rendering test sequences", total, "frames");
+  std::vector<RenderedSequence> out;
+  uint64_t done = 0;
+  for (const StudySequence& s : sequences) {
+    const HandModel proportioned = hand.Reproportioned(s.length, s.width);
+    Sequence sequence(proportioned, s.options);
+    RenderedSequence r{s, {}};
+    for (int i = 0; i < sequence.size(); ++i) {
+      StudyFrame f;
+      f.truth = sequence.Render(i);
+      f.hand_mask = f.truth.labels == static_cast<int>(PixelLabel::kHand);
+      f.intrinsics = sequence.intrinsics();
+      f.hand_length_m = sequence.hand_length_m();
+      r.frames.push_back(std::move(f));
+      line.Update(++done);
+    }
+    out.push_back(std::move(r));
+  }
+  line.Finish();
+  return out;
+}
+
+cv::Mat SegmentationNoise(const cv::Mat& mask, double alpha_percent, uint64_t seed) {
+  NPHAND_THROW_CHECK(!mask.empty() && mask.type() == CV_8UC1, "segmentation noise: the mask must be 8-bit single-channel");
+  NPHAND_THROW_CHECK(std::isfinite(alpha_percent) && alpha_percent >= 0.0 && alpha_percent <= 100.0,
+                     "segmentation noise: alpha must be within [0, 100] percent");
+  cv::Mat out = (mask != 0);
+  if (alpha_percent == 0.0) return out;
+  std::vector<cv::Point> pixels;
+  cv::findNonZero(out, pixels);
+  const size_t remove = static_cast<size_t>(std::llround(alpha_percent / 100.0 * static_cast<double>(pixels.size())));
+  Random random(seed);
+  for (size_t i = 0; i < remove; ++i) {
+    std::swap(pixels[i], pixels[i + random.UniformIndex(pixels.size() - i)]);
+    out.at<uint8_t>(pixels[i]) = 0;
+  }
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+  cv::erode(out, out, kernel);
+  cv::dilate(out, out, kernel);
+  return out;
+}
+
+std::unique_ptr<PoseMethod> MakeEstimatorMethod(const std::string& name, const Database& db, const KnnIndex& index,
+                                                const HandModel& hand, const EstimatorOptions& options, bool from_rgb) {
+  return std::make_unique<EstimatorMethod>(name, db, index, hand, options, from_rgb);
+}
+
+std::unique_ptr<PoseMethod> MakeNearestPoseMethod(const Database& db) { return std::make_unique<NearestPoseMethod>(db); }
+
+std::unique_ptr<PoseMethod> MakeMeanPoseMethod(const Database& db) { return std::make_unique<MeanPoseMethod>(db); }
+
+std::unique_ptr<PoseMethod> MakeRegressionMethod(const Database& db, std::unique_ptr<PoseRegressor> regressor, int rows,
+                                                 uint64_t seed, std::ostream* progress) {
+  return std::make_unique<RegressionMethod>(db, std::move(regressor), rows, seed, progress);
+}
+
+std::vector<MethodScore> RunMethods(std::vector<std::unique_ptr<PoseMethod>>& methods,
+                                    const std::vector<RenderedSequence>& sequences, const std::vector<double>& alphas,
+                                    const HandModel& hand, uint64_t noise_seed, std::ostream* progress) {
+  const double model_length = HandLength(hand.KeypointsOf(HandPose{}));
+  uint64_t total = 0, frames = 0;
+  for (const RenderedSequence& s : sequences) frames += s.frames.size();
+  for (double alpha : alphas) {
+    for (const auto& m : methods) total += (alpha == 0.0 || !m->FromRgb()) ? frames : 0;
+  }
+  ProgressLine line(progress, "methods", total, "frames");
+  uint64_t done = 0;
+  std::vector<MethodScore> scores;
+  for (size_t a = 0; a < alphas.size(); ++a) {
+    const double alpha = alphas[a];
+    // The same noisy masks for every method.
+    std::vector<std::vector<cv::Mat>> masks(sequences.size());
+    for (size_t s = 0; s < sequences.size(); ++s) {
+      for (size_t i = 0; i < sequences[s].frames.size(); ++i) {
+        masks[s].push_back(SegmentationNoise(sequences[s].frames[i].hand_mask, alpha,
+                                             noise_seed + 1000003 * a + 1009 * s + i));
+      }
+    }
+    for (const auto& method : methods) {
+      if (alpha != 0.0 && method->FromRgb()) continue;
+      std::vector<std::vector<FrameFigures>> runs(sequences.size());
+      for (size_t s = 0; s < sequences.size(); ++s) {
+        method->Reset();
+        for (size_t i = 0; i < sequences[s].frames.size(); ++i) {
+          const StudyFrame& frame = sequences[s].frames[i];
+          const Clock::time_point start = Clock::now();
+          const MethodEstimate e = method->Estimate(frame, masks[s][i]);
+          FrameFigures f;
+          f.ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+          f.detected = e.detected;
+          if (e.detected) {
+            const HandPose& truth = frame.truth.pose;
+            f.pose_error = (ToPoseVector(e.pose) - ToPoseVector(truth)).norm();
+            f.estimate = hand.KeypointsOf(e.pose);
+            for (Eigen::Vector3d& k : f.estimate) k *= frame.hand_length_m / model_length;
+            f.truth = frame.truth.keypoints;
+            f.distances = RootRelativeDistances(f.estimate, f.truth);
+            f.keypoint_mm = 1000.0 * RootRelativeError(f.estimate, f.truth);
+            f.pa_mpjpe_mm = 1000.0 * ProcrustesError(f.estimate, f.truth);
+            for (int d = 0; d < kNumDofs; ++d) f.joint_deg += std::abs(e.pose.angles[d] - truth.angles[d]);
+            f.joint_deg *= 180.0 / std::numbers::pi / kNumDofs;
+            f.wrist_deg = RotationAngleDeg(e.pose.camera_from_hand, truth.camera_from_hand);
+            if (e.keypoints_2d) {
+              f.keypoint_px = 0.0;
+              for (int k = 0; k < kNumKeypoints; ++k) f.keypoint_px += ((*e.keypoints_2d)[k] - frame.truth.keypoints_2d[k]).norm();
+              f.keypoint_px /= kNumKeypoints;
+            }
+          }
+          runs[s].push_back(std::move(f));
+          line.Update(++done);
+        }
+      }
+      scores.push_back(Summarise(method->Name(), "all", alpha, runs));
+      for (size_t s = 0; s < sequences.size(); ++s) {
+        scores.push_back(Summarise(method->Name(), sequences[s].sequence.name, alpha, {runs[s]}));
+      }
+    }
+  }
+  line.Finish();
+  // Fig. 6's normalisation: by the NN-pose bound on the same frames.
+  for (MethodScore& s : scores) {
+    s.pose_error_norm = s.keypoint_norm = kNaN;
+    for (const MethodScore& bound : scores) {
+      if (bound.method == "NN pose" && bound.sequence == s.sequence && bound.alpha == s.alpha && bound.detected > 0) {
+        s.pose_error_norm = s.pose_error / bound.pose_error;
+        s.keypoint_norm = s.keypoint_mm / bound.keypoint_mm;
+      }
+    }
+  }
+  return scores;
+}
+
+nlohmann::json ToJson(const MethodScore& s) {
+  return {{"method", s.method},
+          {"sequence", s.sequence},
+          {"alpha", s.alpha},
+          {"frames", s.frames},
+          {"detected", s.detected},
+          {"pose_error", Number(s.pose_error)},
+          {"keypoint_error_mm", Number(s.keypoint_mm)},
+          {"pa_mpjpe_mm", Number(s.pa_mpjpe_mm)},
+          {"within_20mm", Number(s.within_20mm)},
+          {"auc_0_50", Number(s.auc_0_50)},
+          {"keypoint_px", Number(s.keypoint_px)},
+          {"joint_deg", Number(s.joint_deg)},
+          {"wrist_deg", Number(s.wrist_deg)},
+          {"jitter_mm", Number(s.jitter_mm)},
+          {"truth_jitter_mm", Number(s.truth_jitter_mm)},
+          {"ms_median", Number(s.ms_median)},
+          {"pose_error_normalised", Number(s.pose_error_norm)},
+          {"keypoint_error_normalised", Number(s.keypoint_norm)}};
+}
+
+nlohmann::json DescribeSequences(const std::vector<RenderedSequence>& sequences) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const RenderedSequence& r : sequences) {
+    const SequenceOptions& o = r.sequence.options;
+    out.push_back({{"name", r.sequence.name},
+                   {"seed", o.seed},
+                   {"frames", o.frames},
+                   {"size", {o.width, o.height}},
+                   {"grasp", o.grasp},
+                   {"object_scale", o.object_scale},
+                   {"forearm", ToString(o.forearm)},
+                   {"background", ToString(o.background)},
+                   {"skin", o.skin},
+                   {"face", o.face},
+                   {"hand_length_factor", r.sequence.length},
+                   {"hand_width_factor", r.sequence.width}});
+  }
+  return out;
+}
+
+std::string FormatScores(const std::vector<MethodScore>& scores, const std::string& sequence) {
+  std::ostringstream out;
+  out << std::left << std::setw(7) << "alpha" << std::setw(16) << "method" << std::right << std::setw(10) << "detected"
+      << std::setw(8) << "pose" << std::setw(7) << "/NN" << std::setw(9) << "kp_mm" << std::setw(7) << "/NN" << std::setw(8)
+      << "PA_mm" << std::setw(7) << "<20mm" << std::setw(7) << "AUC" << std::setw(7) << "px" << std::setw(8) << "wrist"
+      << std::setw(8) << "jitter" << std::setw(8) << "ms" << "\n";
+  out << std::fixed;
+  auto cell = [&](double v, int width, int precision) {
+    if (std::isfinite(v)) {
+      out << std::setprecision(precision) << std::setw(width) << v;
+    } else {
+      out << std::setw(width) << "-";
+    }
+  };
+  for (const MethodScore& s : scores) {
+    if (s.sequence != sequence) continue;
+    out << std::left << std::setprecision(1) << std::setw(7) << s.alpha << std::setw(16) << s.method << std::right
+        << std::setw(10) << (std::to_string(s.detected) + "/" + std::to_string(s.frames));
+    cell(s.pose_error, 8, 3);
+    cell(s.pose_error_norm, 7, 2);
+    cell(s.keypoint_mm, 9, 1);
+    cell(s.keypoint_norm, 7, 2);
+    cell(s.pa_mpjpe_mm, 8, 1);
+    cell(s.within_20mm, 7, 2);
+    cell(s.auc_0_50, 7, 2);
+    cell(s.keypoint_px, 7, 1);
+    cell(s.wrist_deg, 8, 1);
+    cell(s.jitter_mm, 8, 2);
+    cell(s.ms_median, 8, 2);
+    out << "\n";
+  }
+  return out.str();
+}
+
+
+std::string ToString(PoseStudyPart part) {
+  switch (part) {
+    case PoseStudyPart::kBaselines:
+      return "baselines";
+    case PoseStudyPart::kNoise:
+      return "noise";
+    case PoseStudyPart::kRobustness:
+      return "robustness";
+  }
+  return "?";
+}
+
+bool PoseStudyOptions::Check(std::string* why) const {
+  if (frames < 3 || frames > 10000) {
+    *why = "frames must be within 3..10000";
+  } else if (width < 64 || height < 64 || width > 4096 || height > 4096) {
+    *why = "the frame size must be within 64..4096 pixels a side";
+  } else if (alphas.empty() || std::any_of(alphas.begin(), alphas.end(), [](double a) { return !(a >= 0.0 && a <= 100.0); })) {
+    *why = "alphas must be given, each within [0, 100] percent";
+  } else if (lsq_rows < 2 || gp_rows < 2 || rvm_rows < 2) {
+    *why = "each regression needs at least 2 rows";
+  } else {
+    return true;
+  }
+  return false;
+}
+
+PoseStudyResult RunPoseStudy(PoseStudyPart part, const Database& db, const KnnIndex& index, const HandModel& hand,
+                             const EstimatorOptions& options_base, const PoseStudyOptions& options, std::ostream* progress) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "eval ", ToString(part), ": ", why);
+  const Clock::time_point start = Clock::now();
+  PoseStudyResult result;
+  result.part = ToString(part);
+  const std::vector<RenderedSequence> sequences = RenderSequences(
+      hand,
+      part == PoseStudyPart::kRobustness ? RobustnessSequences(options.frames, options.width, options.height, options.seed + 100)
+                                         : TestSequences(options.frames, options.width, options.height, options.seed),
+      progress);
+  result.sequences = DescribeSequences(sequences);
+
+  EstimatorOptions pnp = options_base;
+  pnp.hand_length_m = ModelHandLength(db);
+  EstimatorOptions nn_feature = pnp;
+  nn_feature.prior = PriorCombination::kNone;
+  std::unique_ptr<KnnIndex> exact;
+  std::vector<std::unique_ptr<PoseMethod>> methods;
+  if (options.exact && part != PoseStudyPart::kRobustness) {
+    exact = std::make_unique<ExactIndex>(DatabaseDescriptors(db));
+    methods.push_back(MakeEstimatorMethod("PNP exact", db, *exact, hand, pnp, false));
+  }
+  methods.push_back(MakeEstimatorMethod("PNP", db, index, hand, pnp, false));
+  methods.push_back(MakeEstimatorMethod("PNP RGB", db, index, hand, pnp, true));
+  methods.push_back(MakeEstimatorMethod("NN feature", db, index, hand, nn_feature, false));
+  methods.push_back(MakeNearestPoseMethod(db));
+  if (part != PoseStudyPart::kRobustness) {
+    methods.push_back(MakeMeanPoseMethod(db));
+    methods.push_back(MakeRegressionMethod(db, MakeLinearRegressor(), options.lsq_rows, options.fit_seed, progress));
+    methods.push_back(MakeRegressionMethod(db, MakeGaussianProcess(), options.gp_rows, options.fit_seed, progress));
+    methods.push_back(MakeRegressionMethod(db, MakeRvm(), options.rvm_rows, options.fit_seed, progress));
+  }
+  result.methods = nlohmann::json::object();
+  for (const auto& m : methods) result.methods[m->Name()] = m->Describe();
+  const std::vector<double> alphas = part == PoseStudyPart::kNoise ? options.alphas : std::vector<double>{0.0};
+  result.scores = RunMethods(methods, sequences, alphas, hand, options.seed ^ 0x9e3779b97f4a7c15ULL, progress);
+  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return result;
+}
+
+nlohmann::json ToJson(const PoseStudyResult& result) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const MethodScore& s : result.scores) rows.push_back(ToJson(s));
+  return {{"part", result.part},   {"sequences", result.sequences}, {"methods", result.methods},
+          {"seconds", result.seconds}, {"rows", rows}};
+}
+
+PoseStudyResult BaselinesOf(const PoseStudyResult& noise) {
+  PoseStudyResult out = noise;
+  out.part = ToString(PoseStudyPart::kBaselines);
+  out.scores.clear();
+  for (const MethodScore& s : noise.scores) {
+    if (s.alpha == 0.0) out.scores.push_back(s);
+  }
+  return out;
+}
+
+std::vector<std::pair<std::string, cv::Mat>> PlotPoseStudy(const PoseStudyResult& result) {
+  std::vector<std::pair<std::string, cv::Mat>> plots;
+  std::vector<std::string> methods;
+  for (const MethodScore& s : result.scores) {
+    if (std::find(methods.begin(), methods.end(), s.method) == methods.end()) methods.push_back(s.method);
+  }
+  const auto at = [&](const std::string& method, const std::string& sequence, double alpha) -> const MethodScore* {
+    for (const MethodScore& s : result.scores) {
+      if (s.method == method && s.sequence == sequence && s.alpha == alpha) return &s;
+    }
+    return nullptr;
+  };
+  if (result.part == "robustness") {
+    std::vector<PlotSeries> series;
+    for (const std::string& m : methods) {
+      PlotSeries line{m, {}, {}};
+      for (size_t v = 0; v < result.sequences.size(); ++v) {
+        const MethodScore* s = at(m, result.sequences[v]["name"].get<std::string>(), 0.0);
+        line.x.push_back(static_cast<double>(v));
+        line.y.push_back(s != nullptr ? s->keypoint_mm : kNaN);
+      }
+      series.push_back(line);
+    }
+    std::string variants;
+    for (size_t v = 0; v < result.sequences.size(); ++v) {
+      variants += (v == 0 ? "" : ", ") + std::to_string(v) + " " + result.sequences[v]["name"].get<std::string>();
+    }
+    plots.emplace_back("robustness_errors", PlotLines(series, "3D keypoint error (mm) per variant", variants));
+  } else {
+    std::vector<std::string> names;
+    std::vector<double> values;
+    for (const std::string& m : methods) {
+      const MethodScore* s = at(m, "all", 0.0);
+      if (s == nullptr) continue;
+      names.push_back(m);
+      values.push_back(s->keypoint_norm);
+    }
+    plots.emplace_back(result.part + "_errors",
+                       PlotBars(names, values, "3D keypoint error / NN-pose bound's, clean masks (Fig. 6)"));
+  }
+  std::vector<PlotSeries> curves;
+  const std::string sequence = result.part == "robustness" ? "base" : "all";
+  for (const std::string& m : methods) {
+    const MethodScore* s = at(m, sequence, 0.0);
+    if (s == nullptr) continue;
+    PlotSeries curve{m, {}, {}};
+    for (int mm = 0; mm <= 50; mm += 2) {
+      curve.x.push_back(mm);
+      curve.y.push_back(FractionWithin(s->distances, mm / 1000.0));
+    }
+    curves.push_back(curve);
+  }
+  plots.emplace_back(result.part + "_curves",
+                     PlotLines(curves, "fraction of keypoints within a distance (" + sequence + ")", "mm"));
+  if (result.part == "noise") {
+    std::vector<PlotSeries> series;
+    for (const std::string& m : methods) {
+      PlotSeries line{m, {}, {}};
+      for (const MethodScore& s : result.scores) {
+        if (s.method == m && s.sequence == "all") {
+          line.x.push_back(s.alpha);
+          line.y.push_back(s.keypoint_mm);
+        }
+      }
+      if (line.x.size() > 1) series.push_back(line);
+    }
+    plots.emplace_back("noise_alpha", PlotLines(series, "3D keypoint error (mm) against segmentation noise (Fig. 7)",
+                                                "alpha: % of hand pixels removed"));
+  }
+  return plots;
+}
+
+}  // namespace nphand
