@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <fstream>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -207,6 +208,45 @@ TEST_F(EstimateCommandTest, BenchPipelineReportsEveryFigure) {
   }
   EXPECT_EQ(report["backend"], "exact");
   EXPECT_GT(report["fps"].get<double>(), 0.0);
+}
+
+// `nphand eval noise` (the figures for checking): every alpha and method, the
+// paper's and today's measures and the errors normalised by the NN-pose bound; JSON and
+// plots written. On the tiny database, with short small sequences.
+TEST_F(EstimateCommandTest, EvalNoiseReportsEveryFigureForEveryAlphaAndMethod) {
+  EvalPoseStudyCommandOptions options;
+  options.db = *dir_ / "tiny.db";
+  options.out_dir = *dir_ / "eval";
+  std::filesystem::create_directories(options.out_dir);
+  options.study.frames = 3;
+  options.study.width = 240;
+  options.study.height = 180;
+  options.study.alphas = {0.0, 5.0};
+  options.study.lsq_rows = 100;
+  options.study.gp_rows = 60;
+  options.study.rvm_rows = 40;
+  const nlohmann::json json = ToJson(RunEvalPoseStudy(PoseStudyPart::kNoise, options));
+  std::set<std::pair<std::string, double>> seen;
+  for (const nlohmann::json& row : json["rows"]) {
+    if (row["sequence"] != "all") continue;
+    seen.insert({row["method"].get<std::string>(), row["alpha"].get<double>()});
+    for (const char* key : {"pose_error", "keypoint_error_mm", "pa_mpjpe_mm", "auc_0_50", "within_20mm",
+                            "pose_error_normalised", "keypoint_error_normalised", "detected", "ms_median"}) {
+      EXPECT_TRUE(row.contains(key)) << key;
+    }
+  }
+  for (const char* method : {"PNP exact", "PNP", "NN feature", "NN pose", "mean pose", "LSQ", "GP", "RVM"}) {
+    EXPECT_TRUE(seen.count({method, 0.0}) && seen.count({method, 5.0})) << method;
+  }
+  EXPECT_TRUE(seen.count({"PNP RGB", 0.0}) && !seen.count({"PNP RGB", 5.0})) << "noise is for masks";
+  EXPECT_EQ(json["sequences"].size(), 5u);
+  for (const char* file : {"noise.json", "noise_errors.png", "noise_curves.png", "noise_alpha.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(options.out_dir / file)) << file;
+  }
+  options.db = *dir_ / "missing.db";
+  testing::ExpectError([&] { RunEvalPoseStudy(PoseStudyPart::kRobustness, options); }, "missing.db");
+  options.out_dir.clear();
+  testing::ExpectError([&] { RunEvalAll(options); }, "--out is required");
 }
 
 }  // namespace
