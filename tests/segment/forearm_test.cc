@@ -46,8 +46,9 @@ double Median(std::vector<double> values) {
 }
 
 // Crops are harsh judges: a sliver of arm left, or of wrist taken, moves the box and with
-// it the whole 64 x 64 crop. The issue asked for IoU >= 0.9; the cut reaches a median of
-// about 0.87 on these 18 frames (docs/estimator.md), against about 0.5 uncut.
+// it the whole 64 x 64 crop. The issue asks for IoU >= 0.9: the cut reaches a median of
+// 0.91 on these 18 frames (docs/estimator.md; half of them, 0.41-0.88, fall short), against
+// about 0.5 uncut.
 TEST(ForearmTest, CutArmsGiveTheCropOfTheHandAlone) {
   std::vector<double> ious, uncut;
   int cut_with = 0, cut_without = 0, frames = 0;
@@ -75,7 +76,7 @@ TEST(ForearmTest, CutArmsGiveTheCropOfTheHandAlone) {
       ++frames;
     }
   }
-  EXPECT_GE(Median(ious), 0.85);
+  EXPECT_GE(Median(ious), 0.9);
   EXPECT_LE(Median(uncut), 0.7);
   EXPECT_GE(cut_with, frames * 8 / 10);
   EXPECT_LE(cut_without, frames / 5);
@@ -103,6 +104,26 @@ TEST(ForearmTest, AnArmLeavingTheFrameObliquelyIsCut) {
             0.9 * cv::countNonZero(labels == static_cast<int>(PixelLabel::kHand)));
   EXPECT_LT(cv::countNonZero(c.hand & (labels == static_cast<int>(PixelLabel::kForearm))),
             0.1 * cv::countNonZero(labels == static_cast<int>(PixelLabel::kForearm)));
+}
+
+TEST(ForearmTest, AnArmWideningTowardsTheHandIsCutNearTheWrist) {
+  // An arm seen in perspective, its near end (the wrist) wider than its far, rounded end,
+  // which does not reach the frame's edge: its narrowest slices are at the far end, yet
+  // the cut belongs near the hand, within 1.5 arm widths of it.
+  cv::Mat body = cv::Mat::zeros(260, 520, CV_8UC1);
+  const std::vector<cv::Point> arm = {{30, 107}, {300, 105}, {300, 155}, {30, 153}};  // 46 -> 50 px wide
+  cv::fillConvexPoly(body, arm, cv::Scalar(255));
+  cv::circle(body, {30, 130}, 23, cv::Scalar(255), cv::FILLED);
+  cv::ellipse(body, cv::Point(385, 130), cv::Size(90, 65), 0, 0, 360, cv::Scalar(255), cv::FILLED);
+  const ForearmCut c = CutForearm(body, 0);
+  ASSERT_TRUE(c.cut);
+  EXPECT_LT(c.arm_direction.x, -0.9) << "from the wrist towards the far end";
+  EXPECT_GT(c.wrist.x, 295 - 1.5 * 48);
+  EXPECT_LT(c.wrist.x, 305);
+  cv::Mat hand = cv::Mat::zeros(body.size(), CV_8UC1);
+  cv::ellipse(hand, cv::Point(385, 130), cv::Size(90, 65), 0, 0, 360, cv::Scalar(255), cv::FILLED);
+  EXPECT_EQ(cv::countNonZero(hand & ~c.hand), 0) << "the whole hand is kept";
+  EXPECT_EQ(cv::countNonZero(c.hand(cv::Rect(0, 0, 220, 260))), 0) << "the far arm is cut away";
 }
 
 TEST(ForearmTest, ARegionWithoutAnArmIsLeftWhole) {

@@ -34,8 +34,9 @@ int EndTouches(const std::vector<cv::Point>& points, const std::vector<double>& 
 
 bool ForearmCutOptions::Check(std::string* why) const {
   if (!(widen_ratio > 1.0 && widen_ratio < 5.0) || !(min_arm_width > 0.0 && min_arm_width < 1.0) ||
-      !(min_arm_length >= 0.0 && min_arm_length < 10.0) || !(min_arm_length_at_edge >= 0.0 && min_arm_length_at_edge < 10.0)) {
-    *why = "forearm cut needs widen ratio in (1, 5), arm width in (0, 1) and arm lengths in [0, 10)";
+      !(min_arm_length >= 0.0 && min_arm_length < 10.0) || !(min_arm_length_at_edge >= 0.0 && min_arm_length_at_edge < 10.0) ||
+      !(wrist_reach > 0.0 && wrist_reach <= 10.0)) {
+    *why = "forearm cut needs widen ratio in (1, 5), arm width in (0, 1), arm lengths in [0, 10) and wrist reach in (0, 10]";
     return false;
   }
   return true;
@@ -113,25 +114,42 @@ Reading Read(const std::vector<cv::Point>& points, cv::Point2d centre, cv::Point
         if (width[index(first)] >= 0.9 * next[next.size() / 2]) break;
       }
     }
+    // The hand starts where the width first exceeds widen_ratio times the narrowest seen.
     double narrowest = 1e300;
-    int at = -1;
+    int hand_start = -1;
     for (int step = first; step < slices; ++step) {
-      const int k = index(step);
-      // An arm of even width is cut where its narrow stretch ends.
-      if (width[k] < narrowest) {
-        narrowest = width[k];
-        at = step;
-      } else if (width[k] <= 1.05 * narrowest) {
-        at = step;
+      const double w = width[index(step)];
+      if (step > first && w > options.widen_ratio * narrowest) {
+        hand_start = step;
+        break;
       }
-      if (step > first && width[k] > options.widen_ratio * narrowest) {
-        *wrist_width = narrowest;
-        // An arm: long enough before the cut and not as thin as a finger.
-        const double length = at_edge ? options.min_arm_length_at_edge : options.min_arm_length;
-        if (at >= length * narrowest && narrowest >= options.min_arm_width * widest) return at;
-        return -1;
+      narrowest = std::min(narrowest, w);
+    }
+    if (hand_start < 0) return -1;
+    // The arm's width is the median of its stretch: an arm seen in perspective tapers, and
+    // its rounded end's last slices are still narrow, so its narrowest slice may lie at the
+    // far end. The wrist is the narrowest place just before the hand: within wrist_reach
+    // arm widths of it, cut where the narrow stretch (within 1 % of the arm's width) ends.
+    std::vector<double> stretch;
+    for (int step = first; step < hand_start; ++step) stretch.push_back(width[index(step)]);
+    std::nth_element(stretch.begin(), stretch.begin() + stretch.size() / 2, stretch.end());
+    const double arm = stretch[stretch.size() / 2];
+    const int from = std::max(first, hand_start - std::max(3, static_cast<int>(std::lround(options.wrist_reach * arm))));
+    double wrist = 1e300;
+    int at = from;
+    for (int step = from; step < hand_start; ++step) {
+      const double w = width[index(step)];
+      if (w < wrist) {
+        wrist = w;
+        at = step;
+      } else if (w <= wrist + 0.01 * arm) {
+        at = step;
       }
     }
+    *wrist_width = wrist;
+    // An arm: long enough before the cut and not as thin as a finger.
+    const double length = at_edge ? options.min_arm_length_at_edge : options.min_arm_length;
+    if (at >= length * arm && arm >= options.min_arm_width * widest) return at;
     return -1;
   };
   double width_low = 0.0, width_high = 0.0;

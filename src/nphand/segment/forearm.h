@@ -1,9 +1,10 @@
 // Cutting a skin region at the wrist: real hands come with a bare forearm that the
 // database's mesh lacks, and an arm in the crop changes its scale and shape. The region's
-// principal axis runs along the arm; its width profile along that axis narrows from the
-// elbow to the wrist and widens at the hand, so the cut goes through the narrowest point
-// before the widening, across the axis. A region without a forearm has no such stretch and
-// is left whole.
+// principal axis runs along the arm; its width profile along that axis is the arm's from
+// the elbow to the wrist and widens at the hand, so the cut goes through the narrowest point
+// just before the widening, across the axis (an arm seen in perspective tapers, so the
+// narrowest point of the whole arm may be its far end). A region without a forearm has no
+// such stretch and is left whole.
 #pragma once
 
 #include <string>
@@ -23,6 +24,9 @@ struct ForearmCutOptions {
   double min_arm_length = 1.2;
   // The same for an end that enters from the frame's edge, as an arm does.
   double min_arm_length_at_edge = 0.3;
+  // The wrist is sought within this many arm widths (the arm's median width) before the
+  // hand's widening.
+  double wrist_reach = 1.5;
   bool Check(std::string* why) const;
 };
 
