@@ -239,6 +239,12 @@ TEST_F(EstimateCommandTest, EvalNoiseReportsEveryFigureForEveryAlphaAndMethod) {
     EXPECT_TRUE(seen.count({method, 0.0}) && seen.count({method, 5.0})) << method;
   }
   EXPECT_TRUE(seen.count({"PNP RGB", 0.0}) && !seen.count({"PNP RGB", 5.0})) << "noise is for masks";
+  for (const nlohmann::json& row : json["rows"]) {
+    if (row["sequence"] != "all") continue;
+    // Frames without a hand: frame 0's empty view of each of the 5 sequences, for RGB methods.
+    EXPECT_EQ(row["no_hand_frames"], row["method"] == "PNP RGB" ? 5 : 0) << row["method"];
+    EXPECT_LE(row["false_detections"].get<int>(), row["no_hand_frames"].get<int>());
+  }
   EXPECT_EQ(json["sequences"].size(), 5u);
   for (const char* file : {"noise.json", "noise_errors.png", "noise_curves.png", "noise_alpha.png"}) {
     EXPECT_TRUE(std::filesystem::exists(options.out_dir / file)) << file;

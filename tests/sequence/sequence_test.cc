@@ -37,6 +37,28 @@ TEST(SequenceTest, SameOptionsGiveTheSameFrames) {
   EXPECT_EQ(a.Describe(), b.Describe());
 }
 
+TEST(SequenceTest, EmptyFramesAreTheViewTheHandWasSeenAgainst) {
+  for (Handedness hand : {Handedness::kRight, Handedness::kLeft}) {
+    SequenceOptions options = Small(testing::kTestSeed + 3);
+    options.face = true;
+    options.hand = hand;
+    Sequence sequence(RightHand(), options);
+    for (int i : {0, 11}) {
+      const SequenceFrame frame = sequence.Render(i);
+      const cv::Mat empty = sequence.RenderEmpty(i);
+      ASSERT_EQ(empty.size(), frame.rgb.size());
+      const cv::Mat background = frame.labels == static_cast<int>(PixelLabel::kBackground);
+      cv::Mat difference, differs;
+      cv::absdiff(empty, frame.rgb, difference);
+      cv::cvtColor(difference, differs, cv::COLOR_BGR2GRAY);
+      differs = differs != 0;
+      EXPECT_EQ(cv::countNonZero(differs & background), 0) << "same background and noise, frame " << i;
+      EXPECT_GT(cv::countNonZero(differs), 1000) << "the hand is gone, frame " << i;
+    }
+  }
+  testing::ExpectError([] { Sequence(RightHand(), Small(1)).RenderEmpty(12); }, "frame 12");
+}
+
 TEST(SequenceTest, GraspAndObjectAreNotTheDatabases) {
   for (uint64_t seed = 1; seed <= 4; ++seed) {
     Sequence sequence(RightHand(), Small(seed));

@@ -246,7 +246,7 @@ struct FrameFigures {
 };
 
 MethodScore Summarise(const std::string& method, const std::string& sequence, double alpha,
-                      const std::vector<std::vector<FrameFigures>>& runs) {
+                      const std::vector<std::vector<FrameFigures>>& runs, const std::vector<std::vector<bool>>& no_hand) {
   MethodScore s;
   s.method = method;
   s.sequence = sequence;
@@ -300,6 +300,10 @@ MethodScore Summarise(const std::string& method, const std::string& sequence, do
   s.jitter_mm = jitter_count > 0 ? 1000.0 * jitter / jitter_count : kNaN;
   s.truth_jitter_mm = jitter_count > 0 ? 1000.0 * truth_jitter / jitter_count : kNaN;
   s.ms_median = Median(ms);
+  for (const std::vector<bool>& found : no_hand) {
+    s.no_hand_frames += static_cast<int>(found.size());
+    s.false_detections += static_cast<int>(std::count(found.begin(), found.end(), true));
+  }
   return s;
 }
 
@@ -384,13 +388,23 @@ std::vector<RenderedSequence> RenderSequences(const HandModel& hand, const std::
   for (const StudySequence& s : sequences) {
     const HandModel proportioned = hand.Reproportioned(s.length, s.width);
     Sequence sequence(proportioned, s.options);
-    RenderedSequence r{s, {}};
+    RenderedSequence r{s, {}, {}};
     for (int i = 0; i < sequence.size(); ++i) {
       StudyFrame f;
       f.truth = sequence.Render(i);
       f.hand_mask = f.truth.labels == static_cast<int>(PixelLabel::kHand);
       f.intrinsics = sequence.intrinsics();
       f.hand_length_m = sequence.hand_length_m();
+      if (i % 10 == 0) {
+        StudyFrame empty;
+        empty.truth.index = i;
+        empty.truth.time_s = f.truth.time_s;
+        empty.truth.rgb = sequence.RenderEmpty(i);
+        empty.hand_mask = cv::Mat::zeros(f.hand_mask.size(), CV_8UC1);
+        empty.intrinsics = f.intrinsics;
+        empty.hand_length_m = f.hand_length_m;
+        r.empty_frames.push_back(std::move(empty));
+      }
       r.frames.push_back(std::move(f));
       line.Update(++done);
     }
@@ -459,6 +473,7 @@ std::vector<MethodScore> RunMethods(std::vector<std::unique_ptr<PoseMethod>>& me
     for (const auto& method : methods) {
       if (alpha != 0.0 && method->FromRgb()) continue;
       std::vector<std::vector<FrameFigures>> runs(sequences.size());
+      std::vector<std::vector<bool>> no_hand(sequences.size());
       for (size_t s = 0; s < sequences.size(); ++s) {
         method->Reset();
         for (size_t i = 0; i < sequences[s].frames.size(); ++i) {
@@ -489,10 +504,16 @@ std::vector<MethodScore> RunMethods(std::vector<std::unique_ptr<PoseMethod>>& me
           runs[s].push_back(std::move(f));
           line.Update(++done);
         }
+        if (method->FromRgb()) {
+          method->Reset();
+          for (const StudyFrame& empty : sequences[s].empty_frames) {
+            no_hand[s].push_back(method->Estimate(empty, empty.hand_mask).detected);
+          }
+        }
       }
-      scores.push_back(Summarise(method->Name(), "all", alpha, runs));
+      scores.push_back(Summarise(method->Name(), "all", alpha, runs, no_hand));
       for (size_t s = 0; s < sequences.size(); ++s) {
-        scores.push_back(Summarise(method->Name(), sequences[s].sequence.name, alpha, {runs[s]}));
+        scores.push_back(Summarise(method->Name(), sequences[s].sequence.name, alpha, {runs[s]}, {no_hand[s]}));
       }
     }
   }
@@ -516,6 +537,8 @@ nlohmann::json ToJson(const MethodScore& s) {
           {"alpha", s.alpha},
           {"frames", s.frames},
           {"detected", s.detected},
+          {"no_hand_frames", s.no_hand_frames},
+          {"false_detections", s.false_detections},
           {"pose_error", Number(s.pose_error)},
           {"keypoint_error_mm", Number(s.keypoint_mm)},
           {"pa_mpjpe_mm", Number(s.pa_mpjpe_mm)},
@@ -554,6 +577,7 @@ nlohmann::json DescribeSequences(const std::vector<RenderedSequence>& sequences)
 std::string FormatScores(const std::vector<MethodScore>& scores, const std::string& sequence) {
   std::ostringstream out;
   out << std::left << std::setw(7) << "alpha" << std::setw(16) << "method" << std::right << std::setw(10) << "detected"
+      << std::setw(9) << "no-hand"
       << std::setw(8) << "pose" << std::setw(7) << "/NN" << std::setw(9) << "kp_mm" << std::setw(7) << "/NN" << std::setw(8)
       << "PA_mm" << std::setw(7) << "<20mm" << std::setw(7) << "AUC" << std::setw(7) << "px" << std::setw(8) << "wrist"
       << std::setw(8) << "jitter" << std::setw(8) << "ms" << "\n";
@@ -568,7 +592,8 @@ std::string FormatScores(const std::vector<MethodScore>& scores, const std::stri
   for (const MethodScore& s : scores) {
     if (s.sequence != sequence) continue;
     out << std::left << std::setprecision(1) << std::setw(7) << s.alpha << std::setw(16) << s.method << std::right
-        << std::setw(10) << (std::to_string(s.detected) + "/" + std::to_string(s.frames));
+        << std::setw(10) << (std::to_string(s.detected) + "/" + std::to_string(s.frames)) << std::setw(9)
+        << (s.no_hand_frames > 0 ? std::to_string(s.false_detections) + "/" + std::to_string(s.no_hand_frames) : "-");
     cell(s.pose_error, 8, 3);
     cell(s.pose_error_norm, 7, 2);
     cell(s.keypoint_mm, 9, 1);

@@ -60,6 +60,9 @@ struct StudyFrame {
 struct RenderedSequence {
   StudySequence sequence;
   std::vector<StudyFrame> frames;
+  // Every tenth frame's view without the hand, object or arm (Sequence::RenderEmpty; its
+  // face stays): what the methods that read RGB must call "no hand".
+  std::vector<StudyFrame> empty_frames;
 };
 // Renders the sequences (the proportioned hands made from `hand`), reporting progress.
 std::vector<RenderedSequence> RenderSequences(const HandModel& hand, const std::vector<StudySequence>& sequences,
@@ -113,6 +116,9 @@ struct MethodScore {
   double alpha = 0.0;              // noise, percent of the hand's pixels
   int frames = 0;
   int detected = 0;
+  // Methods that read RGB, on the frames without a hand: how many, and how many had one found.
+  int no_hand_frames = 0;
+  int false_detections = 0;
   // Means over detected frames.
   double pose_error = 0.0;         // Euclidean, pose-vector space (the paper's first measure)
   double keypoint_mm = 0.0;        // 21 keypoints about the wrist (the paper's second; = root-relative MPJPE)
@@ -132,8 +138,9 @@ struct MethodScore {
   std::vector<double> distances;   // every keypoint distance (metres), for the error curves
 };
 
-// Runs every method over every sequence at every noise level (RGB methods at alpha 0 only)
-// and scores them over all sequences and per sequence.
+// Runs every method over every sequence at every noise level (RGB methods at alpha 0 only,
+// and then over the sequence's frames without a hand) and scores them over all sequences and
+// per sequence.
 std::vector<MethodScore> RunMethods(std::vector<std::unique_ptr<PoseMethod>>& methods,
                                     const std::vector<RenderedSequence>& sequences, const std::vector<double>& alphas,
                                     const HandModel& hand, uint64_t noise_seed, std::ostream* progress);

@@ -162,6 +162,33 @@ JointAngles Sequence::AnglesAt(double step) const {
   return ClampToLimits(angles);
 }
 
+cv::Mat Sequence::BackgroundAt(double t) const {
+  // The camera's pan: the frame is a moving window of the larger background.
+  const int pan_x = static_cast<int>(std::lround(kPanMargin * options_.width * (1.0 + std::sin(2.0 * std::numbers::pi * t + phases_[2]))));
+  const int pan_y = static_cast<int>(std::lround(kPanMargin * options_.height * (1.0 + std::cos(2.0 * std::numbers::pi * t + phases_[3]))));
+  return background_(cv::Rect(std::clamp(pan_x, 0, background_.cols - options_.width),
+                              std::clamp(pan_y, 0, background_.rows - options_.height), options_.width, options_.height));
+}
+
+void Sequence::AddNoise(int i, cv::Mat* bgr) const {
+  if (options_.noise <= 0.0) return;
+  cv::Mat noise(bgr->size(), CV_32FC3);
+  cv::RNG rng(options_.seed * 1000003ULL + static_cast<uint64_t>(i));
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, options_.noise);
+  cv::Mat shaded;
+  bgr->convertTo(shaded, CV_32FC3);
+  cv::Mat(shaded + noise).convertTo(*bgr, CV_8UC3);
+}
+
+cv::Mat Sequence::RenderEmpty(int i) const {
+  NPHAND_THROW_CHECK(i >= 0 && i < options_.frames, "sequence: frame ", i, " is not within 0..", options_.frames - 1);
+  const double t = options_.frames > 1 ? static_cast<double>(i) / (options_.frames - 1) : 0.0;
+  cv::Mat frame = BackgroundAt(t).clone();
+  AddNoise(i, &frame);
+  if (options_.hand == Handedness::kLeft) cv::flip(frame, frame, 1);
+  return frame;
+}
+
 SequenceFrame Sequence::Render(int i) {
   NPHAND_THROW_CHECK(i >= 0 && i < options_.frames, "sequence: frame ", i, " is not within 0..", options_.frames - 1);
   const double t = options_.frames > 1 ? static_cast<double>(i) / (options_.frames - 1) : 0.0;
@@ -191,22 +218,9 @@ SequenceFrame Sequence::Render(int i) {
   if (options_.forearm == ForearmKind::kSleeved) render.sleeve_colour = sleeve_bgr_;
   render.light_direction = light_;
   render.ambient = 0.45;
-  // The camera's pan: the frame is a moving window of the larger background.
-  const int pan_x = static_cast<int>(std::lround(kPanMargin * options_.width * (1.0 + std::sin(2.0 * std::numbers::pi * t + phases_[2]))));
-  const int pan_y = static_cast<int>(std::lround(kPanMargin * options_.height * (1.0 + std::cos(2.0 * std::numbers::pi * t + phases_[3]))));
-  render.background = background_(cv::Rect(std::clamp(pan_x, 0, background_.cols - options_.width),
-                                           std::clamp(pan_y, 0, background_.rows - options_.height), options_.width,
-                                           options_.height));
+  render.background = BackgroundAt(t);
   RenderedImages images = renderer_.Render(scene, intrinsics_, render);
-
-  if (options_.noise > 0.0) {
-    cv::Mat noise(images.rgb.size(), CV_32FC3);
-    cv::RNG rng(options_.seed * 1000003ULL + static_cast<uint64_t>(i));
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, options_.noise);
-    cv::Mat shaded;
-    images.rgb.convertTo(shaded, CV_32FC3);
-    cv::Mat(shaded + noise).convertTo(images.rgb, CV_8UC3);
-  }
+  AddNoise(i, &images.rgb);
   frame.rgb = images.rgb;
   frame.labels = images.labels;
   frame.pose = scene.hand;

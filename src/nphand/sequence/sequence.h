@@ -96,11 +96,19 @@ class Sequence {
   // Frame `i` (0 <= i < size()): the same bytes for the same options.
   SequenceFrame Render(int i);
 
+  // Frame `i`'s view with nothing held up to it: the background (and the face, if any) as
+  // the camera sees it then, with the same sensor noise. For "no hand" checks.
+  cv::Mat RenderEmpty(int i) const;
+
   // What the sequence is, for its files: options, intrinsics, grasp, object.
   nlohmann::json Describe() const;
 
  private:
   JointAngles AnglesAt(double step) const;
+  // The background window the camera sees at time t (0..1 over the sequence).
+  cv::Mat BackgroundAt(double t) const;
+  // Sensor noise of frame i, added in place.
+  void AddNoise(int i, cv::Mat* bgr) const;
 
   const HandModel& hand_;
   SequenceOptions options_;
