@@ -128,6 +128,9 @@ PoseStudyResult RunEvalPoseStudy(PoseStudyPart part, const EvalPoseStudyCommandO
 
 nlohmann::json RunEvalAll(const EvalPoseStudyCommandOptions& options) {
   NPHAND_THROW_CHECK(!options.out_dir.empty(), "eval all: --out is required (the study writes its files there)");
+  // Everything the pose studies read is opened first: a bad option, a missing index or
+  // asset fails now, not after the feature and nearest-neighbour studies.
+  const LoadedStudy loaded(options, "eval all");
   using Clock = std::chrono::steady_clock;
   nlohmann::json summary = {{"machine", MachineDescription()}, {"parts", nlohmann::json::object()}};
   const auto timed = [&](const std::string& name, const auto& run) {
@@ -151,7 +154,6 @@ nlohmann::json RunEvalAll(const EvalPoseStudyCommandOptions& options) {
     ann.study.configs = {"exact", "lsh", "hnswlib-sq8", "faiss-ivf"};
     RunEvalAnn(ann);
   });
-  const LoadedStudy loaded(options, "eval all");
   timed("noise and baselines", [&] {
     const PoseStudyResult noise =
         RunPoseStudy(PoseStudyPart::kNoise, loaded.db, *loaded.index, loaded.hand, EstimatorOptions{}, options.study, &std::cerr);

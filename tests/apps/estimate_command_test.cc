@@ -253,6 +253,14 @@ TEST_F(EstimateCommandTest, EvalNoiseReportsEveryFigureForEveryAlphaAndMethod) {
   testing::ExpectError([&] { RunEvalPoseStudy(PoseStudyPart::kRobustness, options); }, "missing.db");
   options.out_dir.clear();
   testing::ExpectError([&] { RunEvalAll(options); }, "--out is required");
+  // Checked before the long feature and nearest-neighbour studies run.
+  options.out_dir = *dir_ / "eval";
+  options.db = *dir_ / "tiny.db";
+  options.index = *dir_ / "missing.idx";
+  testing::ExpectError([&] { RunEvalAll(options); }, "missing.idx");
+  options.index.clear();
+  options.study.frames = 1;
+  testing::ExpectError([&] { RunEvalAll(options); }, "frames");
 }
 
 }  // namespace
