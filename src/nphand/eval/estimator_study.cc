@@ -60,6 +60,15 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     e.carried = carried;
     out.push_back({"carried" + std::to_string(carried), e});
   }
+  // How often the half-turned crop is searched too (its cost: a second descriptor and search).
+  for (double ambiguity : {0.0, 0.15, 0.3}) {
+    EstimatorOptions e = base;
+    e.prior = PriorCombination::kProduct;
+    e.roll_ambiguity = ambiguity;
+    std::ostringstream name;
+    name << "turns" << ambiguity;
+    out.push_back({name.str(), e});
+  }
   for (int k : {50, 100}) {
     EstimatorOptions e = base;
     e.prior = PriorCombination::kProduct;
@@ -128,7 +137,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     score.name = setting.name;
     score.options = {{"k", e.k},           {"observation", ToString(e.observation)}, {"sigma_y", e.sigma_y},
                      {"prior", ToString(e.prior)}, {"sigma_x", e.sigma_x}, {"prior_share", e.prior_share},
-                     {"carried", e.carried}};
+                     {"carried", e.carried},        {"roll_ambiguity", e.roll_ambiguity}};
     std::vector<double> ms;
     for (const std::vector<SequenceFrame>& frames : sequences) {
       estimator.Reset();
@@ -138,6 +147,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
         ms.push_back(r.ms.total);
         if (!r.detected()) continue;
         ++score.detected;
+        score.both_turns += r.both_turns;
         double joint = 0.0, keypoint = 0.0, px = 0.0, camera = 0.0;
         for (int d = 0; d < kNumDofs; ++d) joint += std::abs(r.pose.angles[d] - truth.pose.angles[d]);
         for (int k = 0; k < kNumKeypoints; ++k) {
@@ -172,6 +182,7 @@ nlohmann::json ToJson(const std::vector<EstimatorScore>& scores) {
                     {"options", s.options},
                     {"frames", s.frames},
                     {"detected", s.detected},
+                    {"both_turns", s.both_turns},
                     {"joint_deg", s.joint_deg},
                     {"wrist_deg", s.wrist_deg},
                     {"keypoint_mm", s.keypoint_mm},
@@ -186,14 +197,15 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
   std::ostringstream out;
   out << std::left << std::setw(22) << "setting" << std::right << std::setw(10) << "detected" << std::setw(10)
       << "joint_deg" << std::setw(10) << "wrist_deg" << std::setw(12) << "keypoint_mm" << std::setw(12) << "keypoint_px"
-      << std::setw(11) << "camera_mm" << std::setw(8) << "ms" << "\n";
+      << std::setw(11) << "camera_mm" << std::setw(8) << "ms" << std::setw(8) << "2turns" << "\n";
   out << std::fixed;
   for (const EstimatorScore& s : scores) {
     out << std::left << std::setw(22) << s.name << std::right << std::setw(10)
         << (std::to_string(s.detected) + "/" + std::to_string(s.frames)) << std::setprecision(2) << std::setw(10)
         << s.joint_deg << std::setw(10) << s.wrist_deg << std::setprecision(1) << std::setw(12) << s.keypoint_mm
         << std::setw(12) << s.keypoint_px << std::setw(11) << s.camera_mm << std::setprecision(2) << std::setw(8)
-        << s.ms_median << "\n";
+        << s.ms_median << std::setprecision(0) << std::setw(7)
+        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%\n";
   }
   return out.str();
 }

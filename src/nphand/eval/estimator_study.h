@@ -44,6 +44,7 @@ struct EstimatorScore {
   nlohmann::json options;      // what differs from the base
   int frames = 0;
   int detected = 0;            // frames with an estimate
+  int both_turns = 0;          // of which searched the half-turned crop too
   double joint_deg = 0.0;      // mean absolute joint-angle error, mean over detected frames
   double wrist_deg = 0.0;      // wrist rotation error, mean
   double keypoint_mm = 0.0;    // mean 3D keypoint error about the wrist (the paper's joint-position measure)

@@ -1,0 +1,67 @@
+#include "nphand/eval/estimator_study.h"
+
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "nphand/index/exact_index.h"
+#include "testing/testing.h"
+#include "testing/tiny_db.h"
+
+namespace nphand {
+namespace {
+
+class EstimatorStudyTest : public testing::TinyDatabaseTest {};
+
+TEST_F(EstimatorStudyTest, EverySettingIsNamedOnceAndVariesWhatItSays) {
+  const EstimatorOptions base;
+  const std::vector<EstimatorSetting> sweep = EstimatorSweep(base);
+  for (const EstimatorSetting& s : sweep) {
+    EXPECT_EQ(std::count_if(sweep.begin(), sweep.end(), [&](const EstimatorSetting& o) { return o.name == s.name; }), 1)
+        << s.name;
+    std::string why;
+    EXPECT_TRUE(s.options.Check(&why)) << s.name << ": " << why;
+  }
+  const auto find = [&](const std::string& name) {
+    return *std::find_if(sweep.begin(), sweep.end(), [&](const EstimatorSetting& s) { return s.name == name; });
+  };
+  EXPECT_EQ(find("nn").options.prior, PriorCombination::kNone);
+  EXPECT_EQ(find("turns0").options.roll_ambiguity, 0.0);
+  EXPECT_EQ(find("k50").options.k, 50);
+  EXPECT_EQ(find("carried20").options.carried, 20);
+}
+
+TEST_F(EstimatorStudyTest, RunsTheNamedSettingsOverTheSequences) {
+  const ExactIndex index(DatabaseDescriptors(db()));
+  EstimatorStudyOptions options;
+  options.sequences = 2;
+  options.frames = 4;
+  options.width = 160;
+  options.height = 120;
+  options.settings = {"nn", "turns0", "turns0.3"};
+  const std::vector<EstimatorScore> scores = RunEstimatorStudy(db(), index, testing::RightHand(), {}, options, nullptr);
+  ASSERT_EQ(scores.size(), 3u);
+  for (const EstimatorScore& s : scores) {
+    EXPECT_EQ(s.frames, 8) << s.name;
+    EXPECT_LE(s.detected, s.frames);
+    EXPECT_LE(s.both_turns, s.detected);
+    EXPECT_GE(s.keypoint_mm, 0.0);
+  }
+  EXPECT_EQ(scores[1].name, "turns0");
+  EXPECT_EQ(scores[1].both_turns, 0) << "never the half turn";
+  EXPECT_EQ(scores[1].options["roll_ambiguity"], 0.0);
+  EXPECT_GE(scores[2].both_turns, scores[1].both_turns);
+  const nlohmann::json json = ToJson(scores);
+  EXPECT_EQ(json.size(), 3u);
+  EXPECT_TRUE(json[0].contains("both_turns"));
+  EXPECT_NE(FormatTable(scores).find("turns0.3"), std::string::npos);
+
+  options.settings = {"nonesuch"};
+  testing::ExpectError([&] { RunEstimatorStudy(db(), index, testing::RightHand(), {}, options, nullptr); }, "nonesuch");
+  options.settings.clear();
+  options.frames = 1;
+  testing::ExpectError([&] { RunEstimatorStudy(db(), index, testing::RightHand(), {}, options, nullptr); }, "frames");
+}
+
+}  // namespace
+}  // namespace nphand
