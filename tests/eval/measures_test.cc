@@ -76,5 +76,11 @@ TEST(MeasuresTest, JitterIsTheMeanSecondDifference) {
   EXPECT_EQ(Jitter(std::vector<Keypoints3d>(2, start)), 0.0);
 }
 
+TEST(MeasuresTest, MedianIsTheUpperMiddleValue) {
+  EXPECT_EQ(Median({}), 0.0);
+  EXPECT_EQ(Median({3.0, 1.0, 2.0}), 2.0);
+  EXPECT_EQ(Median({4.0, 1.0, 3.0, 2.0}), 3.0);
+}
+
 }  // namespace
 }  // namespace nphand

@@ -6,20 +6,12 @@
 #include <numbers>
 #include <sstream>
 
+#include "nphand/eval/measures.h"
 #include "nphand/sequence/sequence.h"
 #include "nphand/util/check.h"
 #include "nphand/util/progress.h"
 
 namespace nphand {
-namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
 
 std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
   std::vector<EstimatorSetting> out;

@@ -9,6 +9,12 @@
 #include "nphand/util/check.h"
 
 namespace nphand {
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
 namespace {
 
 Eigen::Matrix3Xd Columns(const Keypoints3d& keypoints) {

@@ -11,6 +11,10 @@
 
 namespace nphand {
 
+// The upper median of `values` (the element at index n / 2 once sorted), 0 for none: the
+// per-frame timings and errors the studies report.
+double Median(std::vector<double> values);
+
 // Mean distance between corresponding keypoints once both sets are moved so that their
 // roots (keypoint 0, the wrist) meet: root-relative MPJPE, metres.
 double RootRelativeError(const Keypoints3d& estimate, const Keypoints3d& truth);

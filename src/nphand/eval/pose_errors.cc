@@ -69,12 +69,6 @@ double Mean(const std::vector<double>& v) {
   return v.empty() ? 0.0 : s / v.size();
 }
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 }  // namespace
 
 PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std::filesystem::path& poses_path) {

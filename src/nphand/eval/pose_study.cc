@@ -27,12 +27,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 Eigen::Matrix3d RotationOf(const PoseVector& x) {
   Eigen::Matrix3d r;
   for (int i = 0; i < 3; ++i) {
