@@ -1,12 +1,13 @@
 #include "apps/bench_command.h"
 
-#include <chrono>
-#include <optional>
-#include <numbers>
-
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
+#include <numbers>
+#include <optional>
+
+#include <opencv2/core/utility.hpp>
 
 #include "nphand/estimate/estimator.h"
 #include "nphand/index/backends.h"
@@ -51,8 +52,9 @@ nlohmann::json Stage(std::vector<double> ms) {
 }  // namespace
 
 bool BenchPipelineOptions::Check(std::string* why) const {
-  if (frames < 1 || frames > 1000000 || width < 64 || height < 64 || width > 4096 || height > 4096 || k < 1) {
-    *why = "bench pipeline needs at least 1 frame, a frame size of 64..4096 a side and k >= 1";
+  if (frames < 1 || frames > 1000000 || width < 64 || height < 64 || width > 4096 || height > 4096 || k < 1 ||
+      threads < 1 || threads > 256) {
+    *why = "bench pipeline needs at least 1 frame, a frame size of 64..4096 a side, k >= 1 and 1..256 threads";
     return false;
   }
   return true;
@@ -61,6 +63,13 @@ bool BenchPipelineOptions::Check(std::string* why) const {
 nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "bench pipeline: ", why);
+  // OpenCV's thread count is process-wide: set for the run, then given back.
+  const int opencv_threads = cv::getNumThreads();
+  cv::setNumThreads(options.threads);
+  struct Restore {
+    int threads;
+    ~Restore() { cv::setNumThreads(threads); }
+  } restore{opencv_threads};
   const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
   const Database db = Database::Open(options.db);
   const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
@@ -114,7 +123,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
       {"k", options.k},
       {"peak_rss_mb", PeakRssMb()},
       {"rss_after_load_mb", rss_loaded},
-      {"threads", 1},
+      {"threads", options.threads},
       {"machine", MachineDescription()},
   };
 }

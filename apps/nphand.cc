@@ -159,6 +159,7 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   pipeline->add_option("--height", p.height, "Frame height")->capture_default_str();
   pipeline->add_option("--k", p.k, "Neighbours per frame")->capture_default_str();
   pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->capture_default_str();
+  pipeline->add_option("--threads", p.threads, "OpenCV threads for the image work (1: one core)")->capture_default_str();
   pipeline->add_option("--asset-dir", p.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   pipeline->add_flag("--json", json, "Print one JSON object");
   pipeline->callback([&p, &json]() {

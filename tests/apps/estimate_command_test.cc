@@ -7,6 +7,7 @@
 #include <set>
 
 #include <gtest/gtest.h>
+#include <opencv2/core/utility.hpp>
 
 #include "apps/bench_command.h"
 #include "apps/db_command.h"
@@ -199,6 +200,7 @@ TEST_F(EstimateCommandTest, BenchPipelineReportsEveryFigure) {
   options.width = 240;
   options.height = 180;
   options.k = 20;
+  const int threads_before = cv::getNumThreads();
   const nlohmann::json report = RunBenchPipeline(options);
   for (const char* key : {"fps", "ms", "peak_rss_mb", "db_entries", "backend", "k", "machine"}) {
     EXPECT_TRUE(report.contains(key)) << key;
@@ -208,6 +210,11 @@ TEST_F(EstimateCommandTest, BenchPipelineReportsEveryFigure) {
   }
   EXPECT_EQ(report["backend"], "exact");
   EXPECT_GT(report["fps"].get<double>(), 0.0);
+  // One OpenCV thread while it runs; the process's own count afterwards.
+  EXPECT_EQ(report["threads"], 1);
+  EXPECT_EQ(cv::getNumThreads(), threads_before);
+  options.threads = 0;
+  testing::ExpectError([&] { RunBenchPipeline(options); }, "1..256 threads");
 }
 
 // `nphand eval noise` (the figures for checking): every alpha and method, the

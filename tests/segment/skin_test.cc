@@ -132,6 +132,47 @@ TEST(SkinTest, AFrameWithoutSkinHasNoRegionAndAFaceIsMarked) {
   EXPECT_GT(found.regions[0].area, 10000);
 }
 
+// The cascade runs every face_interval frames, and on the frame after a region that could
+// hold a face came into view; a region that moves or grows within its box is not new.
+TEST(SkinTest, TheFaceCascadeLooksWhenSomeoneComesIntoView) {
+  SkinOptions options;
+  options.face_interval = 1000;
+  SkinSegmenter segmenter(options);
+  const cv::Mat wall = MakeBackground(BackgroundKind::kClutter, cv::Size(320, 240), 7);
+  const cv::Vec3f skin = SkinToneByName("medium").bgr;
+  auto blob_at = [&](int x) {
+    cv::Mat frame = wall.clone();
+    cv::ellipse(frame, cv::Point(x, 180), cv::Size(40, 25), 0, 0, 360, cv::Scalar(skin[0], skin[1], skin[2]), cv::FILLED);
+    return frame;
+  };
+  std::vector<bool> looked;
+  for (int x : {60, 70, 80}) looked.push_back(segmenter.Segment(blob_at(x)).faces_looked);
+  // An object splits the blob in two: more regions, but none new.
+  cv::Mat split = blob_at(80);
+  cv::rectangle(split, cv::Rect(74, 140, 12, 80), cv::Scalar(40, 160, 60), cv::FILLED);
+  for (int i = 0; i < 2; ++i) {
+    const SkinSegmentation s = segmenter.Segment(split);
+    EXPECT_EQ(s.regions.size(), 2u);
+    looked.push_back(s.faces_looked);
+  }
+  // The first frame, then a moving blob and its two pieces.
+  EXPECT_EQ(looked, std::vector<bool>({true, false, false, false, false}));
+
+  cv::Mat with_face = split.clone();
+  DrawFace(skin, cv::Point(220, 90), 120, &with_face);
+  const SkinSegmentation came = segmenter.Segment(with_face);
+  EXPECT_FALSE(came.faces_looked);
+  EXPECT_TRUE(came.faces.empty());
+  const SkinSegmentation next = segmenter.Segment(with_face);
+  EXPECT_TRUE(next.faces_looked);
+  ASSERT_EQ(next.faces.size(), 1u);
+  EXPECT_GT(next.face_pixels, 0);
+  EXPECT_EQ(next.regions.size(), 2u);  // the face is set aside; the pieces stay
+  const SkinSegmentation after = segmenter.Segment(with_face);
+  EXPECT_FALSE(after.faces_looked);
+  EXPECT_EQ(after.faces, next.faces);
+}
+
 TEST(SkinTest, BadInputIsRefused) {
   SkinSegmenter segmenter(NoFaces());
   testing::ExpectError([&] { segmenter.Segment(cv::Mat()); }, "8-bit BGR");

@@ -58,8 +58,8 @@ void SkinSegmenter::Reset() {
   rest_hist_ = cv::Mat::zeros(options_.bins, options_.bins, CV_32FC1);
   learned_ = 0;
   frames_ = 0;
-  last_regions_ = -1;
-  regions_changed_ = false;
+  face_sized_.clear();
+  newcomer_ = false;
   faces_.clear();
   RebuildLookup();
 }
@@ -148,20 +148,23 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     cv::morphologyEx(out.skin, out.skin, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
   }
 
-  // Faces: looked for every face_interval frames, and at once when the regions changed in
-  // number on the last frame (someone came into view); the cascade costs more than the rest
-  // of the frame. A face's skin (the head's ellipse and the neck below it) is set aside
-  // before the regions are found, so that a hand in front of a face keeps the rest of itself.
-  const bool look = frames_ % options_.face_interval == 0 || regions_changed_;
+  // Faces: looked for every face_interval frames, and at once when a region that could hold
+  // one came into view on the last frame (someone came in; a hand split by its object, or
+  // moving, is not new); the cascade costs more than the rest of the frame. A face's skin
+  // (the head's ellipse and the neck below it) is set aside before the regions are found,
+  // so that a hand in front of a face keeps the rest of itself.
+  const bool look = frames_ % options_.face_interval == 0 || newcomer_;
   ++frames_;
+  // A face is skin: the cascade looks only around skin regions that could hold one (their
+  // box grown by a quarter of a side each way, for the hair and a face cut by a hand), on
+  // the frame halved until it is at most 320 pixels wide.
+  int halvings = 0;
+  for (int width = work.cols; width > 320; width = (width + 1) / 2) ++halvings;
+  const int look_scale = 1 << halvings;  // working pixels per looked-at pixel
+  constexpr int kMinFace = 24;           // pixels, in the looked-at frame
+  const int face_side = kMinFace * look_scale / 2;  // a region's least side that could hold one, working pixels
   if (detector_ != nullptr && look) {
-    // A face is skin: the cascade looks only around skin regions that could hold one (their
-    // box grown by a quarter of a side each way, for the hair and a face cut by a hand), on
-    // the frame halved until it is at most 320 pixels wide.
-    int halvings = 0;
-    for (int width = work.cols; width > 320; width = (width + 1) / 2) ++halvings;
-    const int look_scale = 1 << halvings;  // working pixels per looked-at pixel
-    constexpr int kMinFace = 24;           // pixels, in the looked-at frame
+    out.faces_looked = true;
     cv::Mat stats, centroids, labels;
     const int count = cv::connectedComponentsWithStats(out.skin, labels, stats, centroids, 8, CV_32S);
     std::vector<cv::Rect> looked;
@@ -169,7 +172,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     for (int label = 1; label < count; ++label) {
       const cv::Rect box(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
                          stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
-      if (box.width < kMinFace * look_scale / 2 || box.height < kMinFace * look_scale / 2) continue;
+      if (box.width < face_side || box.height < face_side) continue;
       const cv::Rect roi =
           cv::Rect(box.x - box.width / 4, box.y - box.height / 4, box.width * 3 / 2, box.height * 3 / 2) &
           cv::Rect(0, 0, work.cols, work.rows);
@@ -225,8 +228,15 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
                                   (centroids.at<double>(label, 1) + 0.5) * scale - 0.5);
     out.regions.push_back(region);
   }
-  regions_changed_ = static_cast<int>(out.regions.size()) != last_regions_;
-  last_regions_ = static_cast<int>(out.regions.size());
+  std::vector<cv::Rect> face_sized;
+  newcomer_ = false;
+  for (const SkinRegion& r : out.regions) {
+    if (r.box.width < face_side * scale || r.box.height < face_side * scale) continue;
+    face_sized.push_back(r.box);
+    newcomer_ = newcomer_ || (!out.faces_looked && std::none_of(face_sized_.begin(), face_sized_.end(),
+                                          [&](const cv::Rect& before) { return (before & r.box).area() > 0; }));
+  }
+  face_sized_ = std::move(face_sized);
   std::sort(out.regions.begin(), out.regions.end(),
             [](const SkinRegion& a, const SkinRegion& b) { return a.area != b.area ? a.area > b.area : a.label < b.label; });
   return out;

@@ -38,10 +38,11 @@ struct SkinOptions {
   int open_px = 3;              // opening removes specks (0: none)
   int close_px = 5;             // closing fills cracks; wider holes stay (the object's)
   double min_area = 0.0003;     // smallest region, as a fraction of the frame (fingertips past an object count)
-  // Faces: the cascade's file ("" finds none), run every face_interval frames and whenever
-  // the skin regions changed in number, around the skin regions large enough to hold a
-  // face, on the frame halved until it is at most 320 pixels wide; each face's head and
-  // neck are set aside from the skin.
+  // Faces: the cascade's file ("" finds none), run every face_interval frames and on the
+  // frame after a skin region large enough to hold a face came into view (its box meets no
+  // such region's box of the frame before), around those regions, on the frame halved
+  // until it is at most 320 pixels wide; each face's head and neck are set aside from the
+  // skin.
   std::string face_cascade = kDefaultFaceCascade;
   int face_interval = 30;
   bool Check(std::string* why) const;
@@ -63,6 +64,7 @@ struct SkinSegmentation {
   std::vector<SkinRegion> regions;  // at least min_area, largest first
   std::vector<cv::Rect> faces;      // the faces in view (the last detection's), frame pixels
   int face_pixels = 0;              // frame pixels of skin set aside as faces (heads and necks)
+  bool faces_looked = false;        // the face cascade ran on this frame
   // The pixels of the regions labelled `which` within `box` (frame pixels), at the frame's
   // resolution: CV_8UC1 of the box's size, 255 = skin.
   cv::Mat Mask(const std::vector<int>& which, cv::Rect box) const;
@@ -93,8 +95,8 @@ class SkinSegmenter {
   cv::Mat hand_hist_, rest_hist_;  // CV_32FC1, bins x bins, each summing to 1
   int learned_ = 0;
   int frames_ = 0;
-  int last_regions_ = -1;
-  bool regions_changed_ = false;
+  std::vector<cv::Rect> face_sized_;  // the last frame's regions that could hold a face
+  bool newcomer_ = false;             // one of them met none of the frame before's
   std::vector<cv::Rect> faces_;
   struct FaceDetector;
   std::shared_ptr<FaceDetector> detector_;
