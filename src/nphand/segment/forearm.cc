@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "nphand/segment/regions.h"
 #include "nphand/util/check.h"
 
 namespace nphand {
@@ -199,14 +200,14 @@ ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions
     if (OnArmSide(reading, reading.t[i])) result.hand.at<uint8_t>(points[i]) = 0;
   }
   // The cut may leave crumbs of the arm's edge: keep the largest piece.
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(result.hand, labels, stats, centroids, 8, CV_32S);
-  if (count > 2) {
-    int best = 1;
-    for (int l = 2; l < count; ++l) {
-      if (stats.at<int>(l, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = l;
+  cv::Mat labels;
+  const std::vector<RegionStats> pieces = LabelRegions(result.hand, &labels);
+  if (pieces.size() > 2) {
+    size_t best = 1;
+    for (size_t l = 2; l < pieces.size(); ++l) {
+      if (pieces[l].area > pieces[best].area) best = l;
     }
-    result.hand = labels == best;
+    result.hand = labels == static_cast<int>(best);
   }
   result.cut = true;
   result.wrist_width = reading.wrist_width;

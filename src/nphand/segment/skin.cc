@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/objdetect.hpp>
 
+#include "nphand/segment/regions.h"
 #include "nphand/util/check.h"
 
 namespace nphand {
@@ -165,13 +166,12 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   const int face_side = kMinFace * look_scale / 2;  // a region's least side that could hold one, working pixels
   if (detector_ != nullptr && look) {
     out.faces_looked = true;
-    cv::Mat stats, centroids, labels;
-    const int count = cv::connectedComponentsWithStats(out.skin, labels, stats, centroids, 8, CV_32S);
+    cv::Mat labels;
+    const std::vector<RegionStats> stats = LabelRegions(out.skin, &labels);
     std::vector<cv::Rect> looked;
     faces_.clear();
-    for (int label = 1; label < count; ++label) {
-      const cv::Rect box(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
-                         stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+    for (size_t label = 1; label < stats.size(); ++label) {
+      const cv::Rect& box = stats[label].box;
       if (box.width < face_side || box.height < face_side) continue;
       const cv::Rect roi =
           cv::Rect(box.x - box.width / 4, box.y - box.height / 4, box.width * 3 / 2, box.height * 3 / 2) &
@@ -209,23 +209,18 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     out.skin.setTo(0, face_mask);
   }
 
-  cv::Mat stats, centroids;
-  const int count = cv::connectedComponentsWithStats(out.skin, out.labels, stats, centroids, 8, CV_32S);
+  const std::vector<RegionStats> stats = LabelRegions(out.skin, &out.labels);
   const int min_area = std::max(1, static_cast<int>(options_.min_area * work.total()));
   const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
-  for (int label = 1; label < count; ++label) {
+  for (size_t label = 1; label < stats.size(); ++label) {
+    const RegionStats& found = stats[label];
+    if (found.area < min_area) continue;
     SkinRegion region;
-    region.label = label;
-    const int area = stats.at<int>(label, cv::CC_STAT_AREA);
-    if (area < min_area) continue;
-    region.area = area * scale * scale;
-    region.box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT) * scale, stats.at<int>(label, cv::CC_STAT_TOP) * scale,
-                          stats.at<int>(label, cv::CC_STAT_WIDTH) * scale,
-                          stats.at<int>(label, cv::CC_STAT_HEIGHT) * scale) &
-                 frame;
+    region.label = static_cast<int>(label);
+    region.area = found.area * scale * scale;
+    region.box = cv::Rect(found.box.x * scale, found.box.y * scale, found.box.width * scale, found.box.height * scale) & frame;
     // A working pixel's centre in the frame's pixel coordinates.
-    region.centroid = cv::Point2d((centroids.at<double>(label, 0) + 0.5) * scale - 0.5,
-                                  (centroids.at<double>(label, 1) + 0.5) * scale - 0.5);
+    region.centroid = cv::Point2d((found.centroid.x + 0.5) * scale - 0.5, (found.centroid.y + 0.5) * scale - 0.5);
     out.regions.push_back(region);
   }
   std::vector<cv::Rect> face_sized;
