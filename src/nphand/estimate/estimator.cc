@@ -294,7 +294,7 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
       const ForearmCut forearm = CutForearm(region, Border(box, bgr.size()), options_.forearm);
       cut = forearm.cut;
       forearm.hand.copyTo(hand(box));
-      if (cut) box = cv::boundingRect(hand);
+      if (cut) box = cv::boundingRect(forearm.hand) + box.tl();
     } else {
       region.copyTo(hand(box));
     }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -12,21 +14,97 @@
 namespace nphand {
 namespace {
 
-struct Profile {
-  std::vector<double> width;  // extent across the axis per 1-pixel slice, smoothed
-  double t0 = 0.0;            // axis coordinate of slice 0
+// Pixels x0..x1 of row y: a region is read as its rows' runs, never pixel by pixel from
+// memory.
+struct Run {
+  int y, x0, x1;
 };
 
-// Which sides of the slice at one end touch the frame: counts of the end's pixels that lie
-// on a bordering edge.
-int EndTouches(const std::vector<cv::Point>& points, const std::vector<double>& t, double from, double to, int border,
-               const cv::Size& size) {
+std::vector<Run> Runs(const cv::Mat& mask) {
+  std::vector<Run> runs;
+  const int width = mask.cols;
+  for (int y = 0; y < mask.rows; ++y) {
+    const uint8_t* row = mask.ptr<uint8_t>(y);
+    int x = 0;
+    while (x < width) {
+      // Eight background pixels at a time.
+      if (x + 8 <= width) {
+        uint64_t eight = 0;
+        std::memcpy(&eight, row + x, sizeof(eight));
+        if (eight == 0) {
+          x += 8;
+          continue;
+        }
+      }
+      if (row[x] == 0) {
+        ++x;
+        continue;
+      }
+      int end = x + 1;
+      while (end < width && row[end] != 0) ++end;
+      runs.push_back({y, x, end - 1});
+      x = end;
+    }
+  }
+  return runs;
+}
+
+// The region's centroid and principal axis angle from its second moments, computed as
+// cv::moments computes them for a binary image (the raw moments are exact integers), so
+// that the axis is OpenCV's to the last bit.
+struct Axis {
+  int64_t pixels = 0;
+  cv::Point2d centre;
+  double angle = 0.0;
+};
+
+Axis AxisOf(const std::vector<Run>& runs) {
+  int64_t m00 = 0, m10 = 0, m01 = 0, m20 = 0, m02 = 0, m11 = 0;
+  auto squares_to = [](int64_t k) { return k * (k + 1) * (2 * k + 1) / 6; };  // 0^2 + ... + k^2
+  for (const Run& r : runs) {
+    const int64_t n = r.x1 - r.x0 + 1, sum_x = (static_cast<int64_t>(r.x0) + r.x1) * n / 2;
+    m00 += n;
+    m10 += sum_x;
+    m01 += r.y * n;
+    m20 += squares_to(r.x1) - squares_to(r.x0 - 1);
+    m02 += static_cast<int64_t>(r.y) * r.y * n;
+    m11 += r.y * sum_x;
+  }
+  Axis axis;
+  axis.pixels = m00;
+  if (m00 == 0) return axis;
+  const double d00 = static_cast<double>(m00), d10 = static_cast<double>(m10), d01 = static_cast<double>(m01);
+  const double inv_m00 = 1.0 / d00, cx = d10 * inv_m00, cy = d01 * inv_m00;
+  const double mu20 = static_cast<double>(m20) - d10 * cx, mu11 = static_cast<double>(m11) - d10 * cy,
+               mu02 = static_cast<double>(m02) - d01 * cy;
+  axis.centre = cv::Point2d(d10 / d00, d01 / d00);
+  axis.angle = 0.5 * std::atan2(2.0 * mu11, mu20 - mu02);
+  return axis;
+}
+
+// A pixel's coordinates along the axis (t) and across it (s).
+struct Frame {
+  cv::Point2d centre, axis, across;
+  double T(int x, int y) const { return (x - centre.x) * axis.x + (y - centre.y) * axis.y; }
+  double S(int x, int y) const { return (x - centre.x) * across.x + (y - centre.y) * across.y; }
+};
+
+// Which sides of the slice at one end touch the frame: counts of the end's pixels (t within
+// [from, to]) that lie on a bordering edge.
+int EndTouches(const std::vector<Run>& runs, const Frame& f, double from, double to, int border, const cv::Size& size) {
   int touches = 0;
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (t[i] < from || t[i] > to) continue;
-    const cv::Point& p = points[i];
-    touches += ((border & 1) && p.x == 0) || ((border & 2) && p.y == 0) || ((border & 4) && p.x == size.width - 1) ||
-               ((border & 8) && p.y == size.height - 1);
+  auto count = [&](int x, int y) {
+    const double t = f.T(x, y);
+    touches += t >= from && t <= to;
+  };
+  for (const Run& r : runs) {
+    if (((border & 2) && r.y == 0) || ((border & 8) && r.y == size.height - 1)) {
+      for (int x = r.x0; x <= r.x1; ++x) count(x, r.y);
+      continue;
+    }
+    const bool left = (border & 1) && r.x0 == 0, right = (border & 4) && r.x1 == size.width - 1;
+    if (left) count(r.x0, r.y);
+    if (right && !(left && r.x0 == r.x1)) count(r.x1, r.y);
   }
   return touches;
 }
@@ -52,33 +130,34 @@ struct Reading {
   double wrist_width = 0.0;
   cv::Point2d wrist;          // the cut's centre
   cv::Point2d centre, axis;   // the axis: through `centre` along `axis` (unit)
-  std::vector<double> t;      // each point's axis coordinate
 };
 
-// The region's points read along `axis` through `centre`.
-Reading Read(const std::vector<cv::Point>& points, cv::Point2d centre, cv::Point2d axis, int border,
-             const cv::Size& size, const ForearmCutOptions& options) {
+// The region's runs read along `axis` through `centre`.
+Reading Read(const std::vector<Run>& runs, cv::Point2d centre, cv::Point2d axis, int border, const cv::Size& size,
+             const ForearmCutOptions& options) {
   Reading r;
   r.centre = centre;
   r.axis = axis;
   const cv::Point2d across(-axis.y, axis.x);
-  r.t.resize(points.size());
-  std::vector<double> s(points.size());
+  const Frame f{centre, axis, across};
   double t_min = 1e300, t_max = -1e300;
-  for (size_t i = 0; i < points.size(); ++i) {
-    const cv::Point2d d = cv::Point2d(points[i]) - centre;
-    r.t[i] = d.dot(axis);
-    s[i] = d.dot(across);
-    t_min = std::min(t_min, r.t[i]);
-    t_max = std::max(t_max, r.t[i]);
+  for (const Run& run : runs) {
+    for (int x = run.x0; x <= run.x1; ++x) {
+      const double t = f.T(x, run.y);
+      t_min = std::min(t_min, t);
+      t_max = std::max(t_max, t);
+    }
   }
   const int slices = static_cast<int>(std::floor(t_max - t_min)) + 1;
   if (slices < 8) return r;
   std::vector<double> low(slices, 1e300), high(slices, -1e300);
-  for (size_t i = 0; i < points.size(); ++i) {
-    const int k = std::min(slices - 1, static_cast<int>(r.t[i] - t_min));
-    low[k] = std::min(low[k], s[i]);
-    high[k] = std::max(high[k], s[i]);
+  for (const Run& run : runs) {
+    for (int x = run.x0; x <= run.x1; ++x) {
+      const int k = std::min(slices - 1, static_cast<int>(f.T(x, run.y) - t_min));
+      const double s = f.S(x, run.y);
+      low[k] = std::min(low[k], s);
+      high[k] = std::max(high[k], s);
+    }
   }
   std::vector<double> raw(slices, 0.0);
   for (int k = 0; k < slices; ++k) raw[k] = high[k] >= low[k] ? high[k] - low[k] + 1.0 : 0.0;
@@ -93,8 +172,8 @@ Reading Read(const std::vector<cv::Point>& points, cv::Point2d centre, cv::Point
   }
   const double widest = *std::max_element(width.begin(), width.end());
   const double reach = 0.05 * slices;
-  const int touch_low = EndTouches(points, r.t, t_min, t_min + reach, border, size);
-  const int touch_high = EndTouches(points, r.t, t_max - reach, t_max, border, size);
+  const int touch_low = EndTouches(runs, f, t_min, t_min + reach, border, size);
+  const int touch_high = EndTouches(runs, f, t_max - reach, t_max, border, size);
 
   // From one end (direction +1: from t_min), the narrow stretch's end before the widening
   // (steps from that end), or -1.
@@ -187,17 +266,18 @@ ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions
   NPHAND_THROW_CHECK(!region.empty() && region.type() == CV_8UC1, "forearm: a region must be an 8-bit single-channel mask");
   ForearmCut result;
   result.hand = region != 0;
-  std::vector<cv::Point> points;
-  cv::findNonZero(result.hand, points);
-  if (points.size() < 50) return result;
-
-  const cv::Moments m = cv::moments(result.hand, true);
-  const double angle = 0.5 * std::atan2(2.0 * m.mu11, m.mu20 - m.mu02);
-  const Reading reading = Read(points, cv::Point2d(m.m10 / m.m00, m.m01 / m.m00), cv::Point2d(std::cos(angle), std::sin(angle)),
-                               border, region.size(), options);
+  const std::vector<Run> runs = Runs(result.hand);
+  const Axis principal = AxisOf(runs);
+  if (principal.pixels < 50) return result;
+  const cv::Point2d axis(std::cos(principal.angle), std::sin(principal.angle));
+  const Reading reading = Read(runs, principal.centre, axis, border, region.size(), options);
   if (reading.direction == 0) return result;
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (OnArmSide(reading, reading.t[i])) result.hand.at<uint8_t>(points[i]) = 0;
+  const Frame f{reading.centre, reading.axis, cv::Point2d(-axis.y, axis.x)};
+  for (const Run& run : runs) {
+    uint8_t* row = result.hand.ptr<uint8_t>(run.y);
+    for (int x = run.x0; x <= run.x1; ++x) {
+      if (OnArmSide(reading, f.T(x, run.y))) row[x] = 0;
+    }
   }
   // The cut may leave crumbs of the arm's edge: keep the largest piece.
   cv::Mat labels;
