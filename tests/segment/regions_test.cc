@@ -53,10 +53,23 @@ TEST(RegionsTest, LabelsAndStatisticsAreOpenCVsOwn) {
   }
 }
 
+TEST(RegionsTest, RunsAreTheRowsNonZeroStretches) {
+  cv::Mat mask = cv::Mat::zeros(3, 20, CV_8UC1);
+  mask(cv::Rect(0, 0, 2, 1)).setTo(1);
+  mask(cv::Rect(9, 0, 11, 1)).setTo(255);  // across the eight-pixel steps, to the edge
+  mask.at<uint8_t>(2, 8) = 3;
+  const std::vector<MaskRun> runs = Runs(mask);
+  ASSERT_EQ(runs.size(), 3u);
+  EXPECT_EQ((std::vector<int>{runs[0].y, runs[0].x0, runs[0].x1}), (std::vector<int>{0, 0, 1}));
+  EXPECT_EQ((std::vector<int>{runs[1].y, runs[1].x0, runs[1].x1}), (std::vector<int>{0, 9, 19}));
+  EXPECT_EQ((std::vector<int>{runs[2].y, runs[2].x0, runs[2].x1}), (std::vector<int>{2, 8, 8}));
+}
+
 TEST(RegionsTest, BadMasksAreRefused) {
   cv::Mat labels;
   testing::ExpectError([&] { LabelRegions(cv::Mat(), &labels); }, "8-bit single-channel");
   testing::ExpectError([&] { LabelRegions(cv::Mat(4, 4, CV_32FC1), &labels); }, "8-bit single-channel");
+  testing::ExpectError([&] { Runs(cv::Mat(4, 4, CV_8UC3)); }, "8-bit single-channel");
 }
 
 }  // namespace

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -14,41 +13,6 @@
 namespace nphand {
 namespace {
 
-// Pixels x0..x1 of row y: a region is read as its rows' runs, never pixel by pixel from
-// memory.
-struct Run {
-  int y, x0, x1;
-};
-
-std::vector<Run> Runs(const cv::Mat& mask) {
-  std::vector<Run> runs;
-  const int width = mask.cols;
-  for (int y = 0; y < mask.rows; ++y) {
-    const uint8_t* row = mask.ptr<uint8_t>(y);
-    int x = 0;
-    while (x < width) {
-      // Eight background pixels at a time.
-      if (x + 8 <= width) {
-        uint64_t eight = 0;
-        std::memcpy(&eight, row + x, sizeof(eight));
-        if (eight == 0) {
-          x += 8;
-          continue;
-        }
-      }
-      if (row[x] == 0) {
-        ++x;
-        continue;
-      }
-      int end = x + 1;
-      while (end < width && row[end] != 0) ++end;
-      runs.push_back({y, x, end - 1});
-      x = end;
-    }
-  }
-  return runs;
-}
-
 // The region's centroid and principal axis angle from its second moments, computed as
 // cv::moments computes them for a binary image (the raw moments are exact integers), so
 // that the axis is OpenCV's to the last bit.
@@ -58,10 +22,10 @@ struct Axis {
   double angle = 0.0;
 };
 
-Axis AxisOf(const std::vector<Run>& runs) {
+Axis AxisOf(const std::vector<MaskRun>& runs) {
   int64_t m00 = 0, m10 = 0, m01 = 0, m20 = 0, m02 = 0, m11 = 0;
   auto squares_to = [](int64_t k) { return k * (k + 1) * (2 * k + 1) / 6; };  // 0^2 + ... + k^2
-  for (const Run& r : runs) {
+  for (const MaskRun& r : runs) {
     const int64_t n = r.x1 - r.x0 + 1, sum_x = (static_cast<int64_t>(r.x0) + r.x1) * n / 2;
     m00 += n;
     m10 += sum_x;
@@ -91,13 +55,13 @@ struct Frame {
 
 // Which sides of the slice at one end touch the frame: counts of the end's pixels (t within
 // [from, to]) that lie on a bordering edge.
-int EndTouches(const std::vector<Run>& runs, const Frame& f, double from, double to, int border, const cv::Size& size) {
+int EndTouches(const std::vector<MaskRun>& runs, const Frame& f, double from, double to, int border, const cv::Size& size) {
   int touches = 0;
   auto count = [&](int x, int y) {
     const double t = f.T(x, y);
     touches += t >= from && t <= to;
   };
-  for (const Run& r : runs) {
+  for (const MaskRun& r : runs) {
     if (((border & 2) && r.y == 0) || ((border & 8) && r.y == size.height - 1)) {
       for (int x = r.x0; x <= r.x1; ++x) count(x, r.y);
       continue;
@@ -133,7 +97,7 @@ struct Reading {
 };
 
 // The region's runs read along `axis` through `centre`.
-Reading Read(const std::vector<Run>& runs, cv::Point2d centre, cv::Point2d axis, int border, const cv::Size& size,
+Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d axis, int border, const cv::Size& size,
              const ForearmCutOptions& options) {
   Reading r;
   r.centre = centre;
@@ -141,7 +105,7 @@ Reading Read(const std::vector<Run>& runs, cv::Point2d centre, cv::Point2d axis,
   const cv::Point2d across(-axis.y, axis.x);
   const Frame f{centre, axis, across};
   double t_min = 1e300, t_max = -1e300;
-  for (const Run& run : runs) {
+  for (const MaskRun& run : runs) {
     for (int x = run.x0; x <= run.x1; ++x) {
       const double t = f.T(x, run.y);
       t_min = std::min(t_min, t);
@@ -151,7 +115,7 @@ Reading Read(const std::vector<Run>& runs, cv::Point2d centre, cv::Point2d axis,
   const int slices = static_cast<int>(std::floor(t_max - t_min)) + 1;
   if (slices < 8) return r;
   std::vector<double> low(slices, 1e300), high(slices, -1e300);
-  for (const Run& run : runs) {
+  for (const MaskRun& run : runs) {
     for (int x = run.x0; x <= run.x1; ++x) {
       const int k = std::min(slices - 1, static_cast<int>(f.T(x, run.y) - t_min));
       const double s = f.S(x, run.y);
@@ -266,14 +230,14 @@ ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions
   NPHAND_THROW_CHECK(!region.empty() && region.type() == CV_8UC1, "forearm: a region must be an 8-bit single-channel mask");
   ForearmCut result;
   result.hand = region != 0;
-  const std::vector<Run> runs = Runs(result.hand);
+  const std::vector<MaskRun> runs = Runs(result.hand);
   const Axis principal = AxisOf(runs);
   if (principal.pixels < 50) return result;
   const cv::Point2d axis(std::cos(principal.angle), std::sin(principal.angle));
   const Reading reading = Read(runs, principal.centre, axis, border, region.size(), options);
   if (reading.direction == 0) return result;
   const Frame f{reading.centre, reading.axis, cv::Point2d(-axis.y, axis.x)};
-  for (const Run& run : runs) {
+  for (const MaskRun& run : runs) {
     uint8_t* row = result.hand.ptr<uint8_t>(run.y);
     for (int x = run.x0; x <= run.x1; ++x) {
       if (OnArmSide(reading, f.T(x, run.y))) row[x] = 0;

@@ -10,51 +10,58 @@
 
 namespace nphand {
 
-std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels) {
+std::vector<MaskRun> Runs(const cv::Mat& mask) {
   NPHAND_THROW_CHECK(!mask.empty() && mask.type() == CV_8UC1, "regions: the mask must be a non-empty 8-bit single-channel image");
+  std::vector<MaskRun> runs;
+  const int width = mask.cols;
+  for (int y = 0; y < mask.rows; ++y) {
+    const uint8_t* row = mask.ptr<uint8_t>(y);
+    int x = 0;
+    while (x < width) {
+      // Eight background pixels at a time.
+      if (x + 8 <= width) {
+        uint64_t eight = 0;
+        std::memcpy(&eight, row + x, sizeof(eight));
+        if (eight == 0) {
+          x += 8;
+          continue;
+        }
+      }
+      if (row[x] == 0) {
+        ++x;
+        continue;
+      }
+      int end = x + 1;
+      while (end < width && row[end] != 0) ++end;
+      runs.push_back({y, x, end - 1});
+      x = end;
+    }
+  }
+  return runs;
+}
+
+std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels) {
+  const std::vector<MaskRun> runs = Runs(mask);
   const int count = cv::connectedComponents(mask, *labels, 8, CV_32S);
   struct Sums {
     int64_t area = 0, x = 0, y = 0;
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
   };
   std::vector<Sums> sums(count);
-  const int width = mask.cols;
-  for (int y = 0; y < mask.rows; ++y) {
-    const uint8_t* in = mask.ptr<uint8_t>(y);
-    const int* row = labels->ptr<int>(y);
-    int x = 0;
-    while (x < width) {
-      // Eight background pixels at a time.
-      if (x + 8 <= width) {
-        uint64_t eight = 0;
-        std::memcpy(&eight, in + x, sizeof(eight));
-        if (eight == 0) {
-          x += 8;
-          continue;
-        }
-      }
-      if (in[x] == 0) {
-        ++x;
-        continue;
-      }
-      const int label = row[x];
-      int end = x + 1;
-      while (end < width && row[end] == label) ++end;
-      Sums& s = sums[label];
-      const int64_t run = end - x;
-      if (s.area == 0) {
-        s.x0 = x;
-        s.y0 = y;
-        s.x1 = end - 1;
-      }
-      s.area += run;
-      s.x += (x + end - 1) * run / 2;  // x + (x + 1) + ... + (end - 1)
-      s.y += y * run;
-      s.x0 = std::min(s.x0, x);
-      s.x1 = std::max(s.x1, end - 1);
-      s.y1 = y;
-      x = end;
+  for (const MaskRun& r : runs) {
+    Sums& s = sums[labels->at<int>(r.y, r.x0)];  // a run is one region's: its pixels touch
+    const int64_t n = r.x1 - r.x0 + 1;
+    if (s.area == 0) {
+      s.x0 = r.x0;
+      s.y0 = r.y;
+      s.x1 = r.x1;
     }
+    s.area += n;
+    s.x += (static_cast<int64_t>(r.x0) + r.x1) * n / 2;  // x0 + (x0 + 1) + ... + x1
+    s.y += r.y * n;
+    s.x0 = std::min(s.x0, r.x0);
+    s.x1 = std::max(s.x1, r.x1);
+    s.y1 = r.y;
   }
   std::vector<RegionStats> stats(count);
   for (int label = 1; label < count; ++label) {

@@ -12,6 +12,15 @@
 
 namespace nphand {
 
+// Pixels x0..x1 (inclusive) of row y.
+struct MaskRun {
+  int y, x0, x1;
+};
+
+// The runs of non-zero pixels of `mask` (CV_8UC1), row by row, left to right: a region read
+// as its runs, not pixel by pixel from memory.
+std::vector<MaskRun> Runs(const cv::Mat& mask);
+
 struct RegionStats {
   int area = 0;          // pixels
   cv::Rect box;          // bounding box
