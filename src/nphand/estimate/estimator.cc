@@ -383,7 +383,18 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
     PoseX x;
     double w = 0.0;
   };
+  // The neighbours' rows lie anywhere in a table of tens of megabytes: ask for them all
+  // before reading any, so that their cache misses overlap.
+  size_t total = 0;
+  for (const Neighbours& n : found) {
+    total += n.ids.size();
+    for (uint32_t id : n.ids) {
+      const char* row = reinterpret_cast<const char*>(&entries_[id]);
+      for (size_t line = 0; line < sizeof(EntryRow); line += 64) __builtin_prefetch(row + line);
+    }
+  }
   std::vector<Candidate> hyp;
+  hyp.reserve(total);
   for (size_t c = 0; c < found.size(); ++c) {
     for (size_t i = 0; i < found[c].ids.size(); ++i) {
       Candidate h;
