@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <set>
 #include <tuple>
 
 #include <gtest/gtest.h>
@@ -128,6 +129,38 @@ TEST_F(EstimatorTest, KeypointsAndDistanceArePlacedInTheFrame) {
     EXPECT_NEAR(r.depth_m, scene.wrist_in_camera.z() + (scene.hand.camera_from_hand * RightHand().bind_centre()).z(),
                 tolerance * distance);
     EXPECT_LT(error_m, tolerance * distance) << distance;
+  }
+}
+
+// The placements of the last few best entries are kept: a frame placed from a kept one and
+// from one made afresh (after more entries than are kept came between) are the same.
+TEST_F(EstimatorTest, PlacementsKeptOrMadeAfreshAreTheSame) {
+  Estimator estimator(*db_, *index_, RightHand(), Options());
+  std::vector<cv::Mat> masks;
+  std::set<size_t> entries;
+  for (size_t from = 0; masks.size() < 40; from += 13) {
+    const size_t e = EntryWithoutObject(*db_, from);
+    if (!entries.insert(e).second) continue;
+    masks.push_back(estimator.RenderEntry(static_cast<uint32_t>(e)).labels == static_cast<int>(PixelLabel::kHand));
+  }
+  std::set<uint32_t> placed;
+  std::vector<FrameResult> first;
+  for (const cv::Mat& mask : masks) {
+    estimator.Reset();
+    first.push_back(estimator.ProcessMask(mask, 0.0));
+    placed.insert(first.back().top[0].entry);
+  }
+  ASSERT_GT(placed.size(), 32u);  // more than are kept
+  for (size_t i : {39u, 38u, 0u, 1u, 20u}) {  // kept, kept, made again, made again, made again
+    estimator.Reset();
+    const FrameResult again = estimator.ProcessMask(masks[i], 0.0);
+    ASSERT_TRUE(again.detected());
+    EXPECT_EQ(again.top[0].entry, first[i].top[0].entry);
+    for (int k = 0; k < kNumKeypoints; ++k) {
+      EXPECT_EQ(again.keypoints_2d[k], first[i].keypoints_2d[k]) << i;
+      EXPECT_EQ(again.keypoints_camera[k], first[i].keypoints_camera[k]) << i;
+    }
+    EXPECT_EQ(again.depth_m, first[i].depth_m);
   }
 }
 

@@ -248,6 +248,30 @@ Scene Estimator::EntryScene(uint32_t entry) {
   return scene;
 }
 
+const Estimator::EntryPlacement& Estimator::PlacementOf(uint32_t entry) {
+  for (EntryPlacement& p : placements_) {
+    if (p.entry == entry) {
+      p.used = frame_;
+      return p;
+    }
+  }
+  const Scene scene = EntryScene(entry);
+  cv::Mat labels;
+  renderer_.RenderLabels(scene, db_intrinsics_, &labels);
+  const std::optional<HandCrop> crop = CropHand(labels == static_cast<int>(PixelLabel::kHand), db_.descriptor().Crop());
+  NPHAND_CHECK(crop.has_value(), "entry ", entry, " has no hand to crop");
+  EntryPlacement made{entry, frame_, crop->crop_from_image, hand_.KeypointsOf(scene.hand), scene.wrist_in_camera};
+  if (placements_.size() < kPlacements) {
+    placements_.push_back(std::move(made));
+    return placements_.back();
+  }
+  // The least recently used makes way.
+  EntryPlacement& oldest = *std::min_element(placements_.begin(), placements_.end(),
+                                              [](const EntryPlacement& a, const EntryPlacement& b) { return a.used < b.used; });
+  oldest = std::move(made);
+  return oldest;
+}
+
 RenderedImages Estimator::RenderEntry(uint32_t entry) {
   NPHAND_THROW_CHECK(entry < db_.size(), "estimator: no database entry ", entry);
   RenderOptions options;
@@ -513,19 +537,14 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   // in its crop; the query's crop maps them into the frame, and the two crops' scales give
   // the distance.
   t = Clock::now();
-  const Scene scene = EntryScene(best.entry);
-  cv::Mat labels;
-  renderer_.RenderLabels(scene, db_intrinsics_, &labels);
-  const std::optional<HandCrop> entry_crop = CropHand(labels == static_cast<int>(PixelLabel::kHand), config.Crop());
-  NPHAND_CHECK(entry_crop.has_value(), "entry ", best.entry, " has no hand to crop");
+  const EntryPlacement& entry = PlacementOf(best.entry);
   const HandCrop& query_crop = crops[best.turn_of];
   const cv::Matx23d frame_from_crop = Invert(query_crop.crop_from_image);
-  const Keypoints3d entry_keypoints = hand_.KeypointsOf(scene.hand);
   const double size = options_.hand_length_m / model_hand_length_;
   const Intrinsics& camera = intrinsics_for(frame);
   // A pixel of the database's render (pixel centres at +0.5) to the frame's.
   auto to_frame = [&](const Eigen::Vector2d& pixel_in_entry) {
-    const Eigen::Vector2d in_crop = Apply(entry_crop->crop_from_image, pixel_in_entry.array() - 0.5);
+    const Eigen::Vector2d in_crop = Apply(entry.crop_from_image, pixel_in_entry.array() - 0.5);
     const Eigen::Vector2d in_roi = Apply(frame_from_crop, in_crop);
     return Eigen::Vector2d(in_roi.x() + roi.x + 0.5, in_roi.y() + roi.y + 0.5);
   };
@@ -539,15 +558,15 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   // The hand centre's distance: the database's, scaled by the focal lengths, the crops'
   // scales and the hand's size.
   const double range = db_distance_ * (camera.fx / db_intrinsics_.fx) * size *
-                       (Scale(query_crop.crop_from_image) / Scale(entry_crop->crop_from_image));
+                       (Scale(query_crop.crop_from_image) / Scale(entry.crop_from_image));
   const Eigen::Matrix3d rotation = towards_ray * AxisAngle(Eigen::Vector3d::UnitZ(), best.turn);
   result.pose.camera_from_hand = towards_ray * result.pose.camera_from_hand;
   for (Hypothesis& h : result.top) h.pose.camera_from_hand = towards_ray * h.pose.camera_from_hand;
   const Eigen::Vector3d wrist = range * ray - size * (result.pose.camera_from_hand * hand_.bind_centre());
   result.depth_m = range * ray.z();
   for (int k = 0; k < kNumKeypoints; ++k) {
-    result.keypoints_2d[k] = to_frame(Project(db_intrinsics_, scene.wrist_in_camera + entry_keypoints[k]));
-    result.keypoints_hand[k] = size * (rotation * entry_keypoints[k]);
+    result.keypoints_2d[k] = to_frame(Project(db_intrinsics_, entry.wrist_in_camera + entry.keypoints[k]));
+    result.keypoints_hand[k] = size * (rotation * entry.keypoints[k]);
     result.keypoints_camera[k] = wrist + result.keypoints_hand[k];
   }
   result.box = box;

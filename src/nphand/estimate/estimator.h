@@ -176,6 +176,20 @@ class Estimator {
   PoseVector PoseOf(uint32_t entry) const;
   JointAngles AnglesOf(uint32_t entry) const;
 
+  // Where an entry's keypoints lie in its render and its crop: the render costs a quarter of
+  // a millisecond, and in a video the best entry is mostly one of the last few frames', so
+  // the last kPlacements are kept (a pure function of the entry: kept or made afresh, the
+  // figures are the same).
+  struct EntryPlacement {
+    uint32_t entry = 0;
+    int used = -1;                      // the last frame that needed it
+    cv::Matx23d crop_from_image;        // the entry's render to its crop
+    Keypoints3d keypoints;              // hand-centred, camera orientation
+    Eigen::Vector3d wrist_in_camera;
+  };
+  static constexpr size_t kPlacements = 32;
+  const EntryPlacement& PlacementOf(uint32_t entry);
+
   const Database& db_;
   std::vector<EntryRow> entries_;  // by entry number
   const KnnIndex& index_;
@@ -189,6 +203,7 @@ class Estimator {
   std::vector<std::optional<Grasp>> grasps_;  // by taxonomy number: those the database holds with an object
   double model_hand_length_ = 0.0;
   mutable Intrinsics frame_intrinsics_;
+  std::vector<EntryPlacement> placements_;
   std::vector<WeightedPose> carried_;
   std::optional<cv::Point2d> last_centre_;
   int frame_ = 0;
