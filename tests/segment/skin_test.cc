@@ -173,6 +173,38 @@ TEST(SkinTest, TheFaceCascadeLooksWhenSomeoneComesIntoView) {
   EXPECT_EQ(after.faces, next.faces);
 }
 
+// Between the cascade's looks a face found is followed as the camera moves; a face that is
+// gone keeps its place until the next look.
+TEST(SkinTest, AFaceFoundIsFollowedBetweenLooks) {
+  SkinOptions options;
+  options.face_interval = 1000;
+  SkinSegmenter segmenter(options);
+  const cv::Mat wall = MakeBackground(BackgroundKind::kClutter, cv::Size(640, 480), 3);
+  const cv::Vec3f skin = SkinToneByName("olive").bgr;
+  auto face_at = [&](int x, int y) {
+    cv::Mat frame = wall.clone();
+    DrawFace(skin, cv::Point(x, y), 180, &frame);
+    return frame;
+  };
+  const SkinSegmentation first = segmenter.Segment(face_at(300, 220));
+  ASSERT_TRUE(first.faces_looked);
+  ASSERT_EQ(first.faces.size(), 1u);
+  cv::Rect at = first.faces[0];
+  for (int step = 1; step <= 4; ++step) {
+    const SkinSegmentation next = segmenter.Segment(face_at(300 + 12 * step, 220 - 6 * step));
+    EXPECT_FALSE(next.faces_looked);
+    ASSERT_EQ(next.faces.size(), 1u);
+    EXPECT_NEAR(next.faces[0].x - at.x, 12, 3) << step;
+    EXPECT_NEAR(next.faces[0].y - at.y, -6, 3) << step;
+    EXPECT_EQ(next.faces[0].size(), at.size());
+    EXPECT_TRUE(next.regions.empty());  // the whole face set aside
+    at = next.faces[0];
+  }
+  const SkinSegmentation gone = segmenter.Segment(wall);
+  ASSERT_EQ(gone.faces.size(), 1u);
+  EXPECT_EQ(gone.faces[0], at);
+}
+
 TEST(SkinTest, BadInputIsRefused) {
   SkinSegmenter segmenter(NoFaces());
   testing::ExpectError([&] { segmenter.Segment(cv::Mat()); }, "8-bit BGR");

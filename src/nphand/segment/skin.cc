@@ -1,6 +1,7 @@
 #include "nphand/segment/skin.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <vector>
 
@@ -62,6 +63,7 @@ void SkinSegmenter::Reset() {
   face_sized_.clear();
   newcomer_ = false;
   faces_.clear();
+  face_looks_.clear();
   RebuildLookup();
 }
 
@@ -151,20 +153,23 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
 
   // Faces: looked for every face_interval frames, and at once when a region that could hold
   // one came into view on the last frame (someone came in; a hand split by its object, or
-  // moving, is not new); the cascade costs more than the rest of the frame. A face's skin
-  // (the head's ellipse and the neck below it) is set aside before the regions are found,
-  // so that a hand in front of a face keeps the rest of itself.
+  // moving, is not new); the cascade costs more than the rest of the frame. Between looks
+  // each face found is followed, as the camera moves. A face's skin (the head's ellipse and
+  // the neck below it) is set aside before the regions are found, so that a hand in front
+  // of a face keeps the rest of itself.
   const bool look = frames_ % options_.face_interval == 0 || newcomer_;
   ++frames_;
-  // A face is skin: the cascade looks only around skin regions that could hold one (their
-  // box grown by a quarter of a side each way, for the hair and a face cut by a hand), on
-  // the frame halved until it is at most 320 pixels wide.
+  // The cascade sees the frame halved until it is at most 320 pixels wide.
   int halvings = 0;
   for (int width = work.cols; width > 320; width = (width + 1) / 2) ++halvings;
   const int look_scale = 1 << halvings;  // working pixels per looked-at pixel
+  const int to_frame = look_scale * scale;
   constexpr int kMinFace = 24;           // pixels, in the looked-at frame
   const int face_side = kMinFace * look_scale / 2;  // a region's least side that could hold one, working pixels
+  const cv::Rect whole(0, 0, work.cols, work.rows);
   if (detector_ != nullptr && look) {
+    // A face is skin: the cascade looks only around skin regions that could hold one (their
+    // box grown by a quarter of a side each way, for the hair and a face cut by a hand).
     out.faces_looked = true;
     cv::Mat labels;
     const std::vector<RegionStats> stats = LabelRegions(out.skin, &labels);
@@ -174,8 +179,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
       const cv::Rect& box = stats[label].box;
       if (box.width < face_side || box.height < face_side) continue;
       const cv::Rect roi =
-          cv::Rect(box.x - box.width / 4, box.y - box.height / 4, box.width * 3 / 2, box.height * 3 / 2) &
-          cv::Rect(0, 0, work.cols, work.rows);
+          cv::Rect(box.x - box.width / 4, box.y - box.height / 4, box.width * 3 / 2, box.height * 3 / 2) & whole;
       if (std::any_of(looked.begin(), looked.end(), [&](const cv::Rect& r) { return (r & roi) == roi; })) continue;
       looked.push_back(roi);
       cv::Mat grey;
@@ -185,7 +189,6 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
       cv::equalizeHist(grey, grey);
       std::vector<cv::Rect> found;
       detector_->cascade.detectMultiScale(grey, found, 1.1, 4, 0, cv::Size(kMinFace, kMinFace));
-      const int to_frame = look_scale * scale;
       for (const cv::Rect& f : found) {
         const cv::Rect face(roi.x * scale + f.x * to_frame, roi.y * scale + f.y * to_frame, f.width * to_frame,
                             f.height * to_frame);
@@ -193,6 +196,38 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
           faces_.push_back(face);
         }
       }
+    }
+    face_looks_.clear();
+    for (const cv::Rect& face : faces_) {
+      const cv::Rect at = cv::Rect(face.x / scale, face.y / scale, face.width / scale, face.height / scale) & whole;
+      cv::Mat grey, looks;
+      cv::cvtColor(work(at), grey, cv::COLOR_BGR2GRAY);
+      cv::resize(grey, looks, cv::Size(kFollowSide, kFollowSide * at.height / std::max(1, at.width)), 0.0, 0.0, cv::INTER_AREA);
+      face_looks_.push_back(looks);
+    }
+  } else {
+    // Each face is followed: its grey look where it was last seen (kFollowSide pixels wide)
+    // matched around there, a face's side each way; where it matches it is the face's new
+    // place and look (a turned or nearer face changes its look a little each frame).
+    for (size_t i = 0; i < faces_.size(); ++i) {
+      cv::Rect& face = faces_[i];
+      const cv::Rect at(face.x / scale, face.y / scale, face.width / scale, face.height / scale);
+      const cv::Rect roi = cv::Rect(at.x - at.width, at.y - at.height, at.width * 3, at.height * 3) & whole;
+      const double shrink = static_cast<double>(kFollowSide) / at.width;
+      cv::Mat grey, small;
+      cv::cvtColor(work(roi), grey, cv::COLOR_BGR2GRAY);
+      cv::resize(grey, small, cv::Size(), shrink, shrink, cv::INTER_AREA);
+      const cv::Mat& looks = face_looks_[i];
+      if (small.cols < looks.cols || small.rows < looks.rows) continue;
+      cv::Mat score;
+      cv::matchTemplate(small, looks, score, cv::TM_CCOEFF_NORMED);
+      double best = 0.0;
+      cv::Point where;
+      cv::minMaxLoc(score, nullptr, &best, nullptr, &where);
+      if (best < kFollowScore) continue;  // not seen (covered, or gone): it stays until the next look
+      face.x = (roi.x + static_cast<int>(std::lround(where.x / shrink))) * scale;
+      face.y = (roi.y + static_cast<int>(std::lround(where.y / shrink))) * scale;
+      small(cv::Rect(where, looks.size())).copyTo(face_looks_[i]);
     }
   }
   out.faces = faces_;

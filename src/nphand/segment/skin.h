@@ -41,8 +41,9 @@ struct SkinOptions {
   // Faces: the cascade's file ("" finds none), run every face_interval frames and on the
   // frame after a skin region large enough to hold a face came into view (its box meets no
   // such region's box of the frame before), around those regions, on the frame halved
-  // until it is at most 320 pixels wide; each face's head and neck are set aside from the
-  // skin.
+  // until it is at most 320 pixels wide; between its runs each face found is followed (its
+  // grey look at detection matched around where it was); each face's head and neck are set
+  // aside from the skin.
   std::string face_cascade = kDefaultFaceCascade;
   int face_interval = 30;
   bool Check(std::string* why) const;
@@ -98,6 +99,9 @@ class SkinSegmenter {
   std::vector<cv::Rect> face_sized_;  // the last frame's regions that could hold a face
   bool newcomer_ = false;             // one of them met none of the frame before's
   std::vector<cv::Rect> faces_;
+  std::vector<cv::Mat> face_looks_;  // by face: its grey pixels where last seen, kFollowSide wide
+  static constexpr int kFollowSide = 24;
+  static constexpr double kFollowScore = 0.5;  // normalised correlation a followed face must reach
   struct FaceDetector;
   std::shared_ptr<FaceDetector> detector_;
 };
