@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "nphand/features/crop.h"
+#include "nphand/segment/regions.h"
 #include "nphand/segment/skin.h"
 #include "nphand/sequence/sequence.h"
 #include "testing/testing.h"
@@ -124,6 +125,23 @@ TEST(ForearmTest, AnArmWideningTowardsTheHandIsCutNearTheWrist) {
   cv::ellipse(hand, cv::Point(385, 130), cv::Size(90, 65), 0, 0, 360, cv::Scalar(255), cv::FILLED);
   EXPECT_EQ(cv::countNonZero(hand & ~c.hand), 0) << "the whole hand is kept";
   EXPECT_EQ(cv::countNonZero(c.hand(cv::Rect(0, 0, 220, 260))), 0) << "the far arm is cut away";
+}
+
+// A held object splits the hand: the pieces the region had before the cut stay (only the
+// crumbs the cut itself makes of a piece go).
+TEST(ForearmTest, PiecesAnObjectSplitOffTheHandStay) {
+  cv::Mat region = cv::Mat::zeros(300, 200, CV_8UC1);
+  cv::ellipse(region, cv::Point(100, 110), cv::Size(60, 70), 0, 0, 360, cv::Scalar(255), cv::FILLED);  // hand
+  cv::rectangle(region, cv::Rect(75, 150, 50, 150), cv::Scalar(255), cv::FILLED);                       // arm
+  cv::rectangle(region, cv::Rect(0, 60, 200, 12), cv::Scalar(0), cv::FILLED);  // the object's gap...
+  const cv::Mat fingers = region(cv::Rect(0, 0, 200, 60)).clone();              // ...leaves fingertips apart
+  const ForearmCut c = CutForearm(region, 8);
+  ASSERT_TRUE(c.cut);
+  ASSERT_GT(cv::countNonZero(fingers), 500);
+  EXPECT_EQ(cv::countNonZero(fingers & ~c.hand(cv::Rect(0, 0, 200, 60))), 0) << "the fingertips stay";
+  EXPECT_EQ(cv::countNonZero(c.hand(cv::Rect(0, 230, 200, 70))), 0) << "the arm goes";
+  cv::Mat labels;
+  EXPECT_EQ(LabelRegions(c.hand, &labels).size(), 3u) << "two pieces: palm and fingertips";
 }
 
 TEST(ForearmTest, ARegionWithoutAnArmIsLeftWhole) {

@@ -49,6 +49,11 @@ TEST(RegionsTest, LabelsAndStatisticsAreOpenCVsOwn) {
                                        stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT)));
       EXPECT_EQ(found[l].centroid.x, centroids.at<double>(l, 0));
       EXPECT_EQ(found[l].centroid.y, centroids.at<double>(l, 1));
+      // The first pixel: in the box's top row, the region's own, and no earlier one of it.
+      const cv::Point first = found[l].first;
+      EXPECT_EQ(first.y, found[l].box.y);
+      EXPECT_EQ(labels.at<int>(first), l);
+      for (int x = 0; x < first.x; ++x) EXPECT_NE(labels.at<int>(first.y, x), l);
     }
   }
 }

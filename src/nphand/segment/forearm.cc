@@ -243,15 +243,27 @@ ForearmCut CutForearm(const cv::Mat& region, int border, const ForearmCutOptions
       if (OnArmSide(reading, f.T(x, run.y))) row[x] = 0;
     }
   }
-  // The cut may leave crumbs of the arm's edge: keep the largest piece.
+  // The cut may leave crumbs of the arm's edge: of each piece the region had before the cut
+  // (an object splits a held hand into several), keep the largest part.
   cv::Mat labels;
-  const std::vector<RegionStats> pieces = LabelRegions(result.hand, &labels);
-  if (pieces.size() > 2) {
-    size_t best = 1;
-    for (size_t l = 2; l < pieces.size(); ++l) {
-      if (pieces[l].area > pieces[best].area) best = l;
+  const std::vector<RegionStats> parts = LabelRegions(result.hand, &labels);
+  if (parts.size() > 2) {
+    cv::Mat before;
+    const std::vector<RegionStats> pieces = LabelRegions(region, &before);
+    std::vector<int> largest(pieces.size(), 0);  // by piece: its largest part's label
+    for (size_t l = 1; l < parts.size(); ++l) {
+      int& best = largest[before.at<int>(parts[l].first)];
+      if (best == 0 || parts[l].area > parts[best].area) best = static_cast<int>(l);
     }
-    result.hand = labels == static_cast<int>(best);
+    std::vector<uint8_t> keep(parts.size(), 0);
+    for (int l : largest) {
+      if (l > 0) keep[l] = 255;
+    }
+    for (int y = 0; y < labels.rows; ++y) {
+      const int* in = labels.ptr<int>(y);
+      uint8_t* out = result.hand.ptr<uint8_t>(y);
+      for (int x = 0; x < labels.cols; ++x) out[x] = keep[in[x]];
+    }
   }
   result.cut = true;
   result.wrist_width = reading.wrist_width;

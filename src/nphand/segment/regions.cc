@@ -46,6 +46,7 @@ std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels) {
   struct Sums {
     int64_t area = 0, x = 0, y = 0;
     int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+    cv::Point first;
   };
   std::vector<Sums> sums(count);
   for (const MaskRun& r : runs) {
@@ -55,6 +56,7 @@ std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels) {
       s.x0 = r.x0;
       s.y0 = r.y;
       s.x1 = r.x1;
+      s.first = cv::Point(r.x0, r.y);
     }
     s.area += n;
     s.x += (static_cast<int64_t>(r.x0) + r.x1) * n / 2;  // x0 + (x0 + 1) + ... + x1
@@ -70,6 +72,7 @@ std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels) {
     r.area = static_cast<int>(s.area);
     r.box = cv::Rect(s.x0, s.y0, s.x1 - s.x0 + 1, s.y1 - s.y0 + 1);
     r.centroid = cv::Point2d(static_cast<double>(s.x) / s.area, static_cast<double>(s.y) / s.area);
+    r.first = s.first;
   }
   return stats;
 }

@@ -25,6 +25,7 @@ struct RegionStats {
   int area = 0;          // pixels
   cv::Rect box;          // bounding box
   cv::Point2d centroid;  // mean pixel position (integers at pixel centres)
+  cv::Point first;       // its first pixel in raster order
 };
 
 // Labels the 8-connected regions of the non-zero pixels of `mask` (CV_8UC1) into `labels`
