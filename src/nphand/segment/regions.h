@@ -3,7 +3,7 @@
 // OpenCV labels the regions (cv::connectedComponents); the statistics come from one pass
 // over the label image's runs. cv::connectedComponentsWithStats gives the same labels and
 // the same figures, but its statistics cost eight times its labelling (480 against 56 us
-// for a 320 x 240 frame on one core), the largest part of segmenting a frame.
+// for a 320 x 240 frame on one core), which had been the largest part of segmenting a frame.
 #pragma once
 
 #include <vector>
