@@ -144,6 +144,22 @@ TEST(ForearmTest, PiecesAnObjectSplitOffTheHandStay) {
   EXPECT_EQ(LabelRegions(c.hand, &labels).size(), 3u) << "two pieces: palm and fingertips";
 }
 
+// A thumb held out sideways makes a few slices far wider than the palm; next to them the arm
+// would pass for a finger, and the fingers' end for the arm.
+TEST(ForearmTest, AThumbHeldOutDoesNotHideTheArm) {
+  cv::Mat region = cv::Mat::zeros(320, 240, CV_8UC1);
+  cv::rectangle(region, cv::Rect(98, 0, 44, 160), cv::Scalar(255), cv::FILLED);               // arm, from the top edge
+  cv::ellipse(region, cv::Point(120, 200), cv::Size(48, 55), 0, 0, 360, cv::Scalar(255), cv::FILLED);  // palm
+  cv::rectangle(region, cv::Rect(10, 185, 220, 12), cv::Scalar(255), cv::FILLED);              // thumb (and a finger) out
+  for (int x : {95, 113, 131}) cv::rectangle(region, cv::Rect(x, 250, 12, 60), cv::Scalar(255), cv::FILLED);  // fingers
+  const ForearmCut c = CutForearm(region, 2);
+  ASSERT_TRUE(c.cut);
+  EXPECT_LT(c.arm_direction.y, -0.9) << "the arm is the top end";
+  EXPECT_EQ(cv::countNonZero(c.hand(cv::Rect(0, 0, 240, 100))), 0) << "the arm goes";
+  EXPECT_EQ(cv::countNonZero(region(cv::Rect(0, 240, 240, 80)) & ~c.hand(cv::Rect(0, 240, 240, 80))), 0)
+      << "the fingers stay";
+}
+
 TEST(ForearmTest, ARegionWithoutAnArmIsLeftWhole) {
   cv::Mat disc = cv::Mat::zeros(200, 200, CV_8UC1);
   cv::circle(disc, cv::Point(100, 100), 60, cv::Scalar(255), cv::FILLED);

@@ -134,7 +134,12 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
     for (int j = std::max(0, k - half); j <= std::min(slices - 1, k + half); ++j, ++n) sum += raw[j];
     width[k] = sum / n;
   }
-  const double widest = *std::max_element(width.begin(), width.end());
+  // The widest part, as the 90th percentile of the widths: a thumb held out sideways makes
+  // a few slices far wider than the palm, next to which the arm would pass for a finger.
+  std::vector<double> sorted = width;
+  const size_t percentile = (sorted.size() - 1) * 9 / 10;
+  std::nth_element(sorted.begin(), sorted.begin() + percentile, sorted.end());
+  const double widest = sorted[percentile];
   const double reach = 0.05 * slices;
   const int touch_low = EndTouches(runs, f, t_min, t_min + reach, border, size);
   const int touch_high = EndTouches(runs, f, t_max - reach, t_max, border, size);
