@@ -249,9 +249,10 @@ Scene Estimator::EntryScene(uint32_t entry) {
 }
 
 const Estimator::EntryPlacement& Estimator::PlacementOf(uint32_t entry) {
+  ++placements_clock_;
   for (EntryPlacement& p : placements_) {
     if (p.entry == entry) {
-      p.used = frame_;
+      p.used = placements_clock_;
       return p;
     }
   }
@@ -260,7 +261,7 @@ const Estimator::EntryPlacement& Estimator::PlacementOf(uint32_t entry) {
   renderer_.RenderLabels(scene, db_intrinsics_, &labels);
   const std::optional<HandCrop> crop = CropHand(labels == static_cast<int>(PixelLabel::kHand), db_.descriptor().Crop());
   NPHAND_CHECK(crop.has_value(), "entry ", entry, " has no hand to crop");
-  EntryPlacement made{entry, frame_, crop->crop_from_image, hand_.KeypointsOf(scene.hand), scene.wrist_in_camera};
+  EntryPlacement made{entry, placements_clock_, crop->crop_from_image, hand_.KeypointsOf(scene.hand), scene.wrist_in_camera};
   if (placements_.size() < kPlacements) {
     placements_.push_back(std::move(made));
     return placements_.back();

@@ -182,7 +182,7 @@ class Estimator {
   // figures are the same).
   struct EntryPlacement {
     uint32_t entry = 0;
-    int used = -1;                      // the last frame that needed it
+    uint64_t used = 0;                  // when it was last needed (placements_clock_)
     cv::Matx23d crop_from_image;        // the entry's render to its crop
     Keypoints3d keypoints;              // hand-centred, camera orientation
     Eigen::Vector3d wrist_in_camera;
@@ -204,6 +204,7 @@ class Estimator {
   double model_hand_length_ = 0.0;
   mutable Intrinsics frame_intrinsics_;
   std::vector<EntryPlacement> placements_;
+  uint64_t placements_clock_ = 0;  // counts the placements asked for
   std::vector<WeightedPose> carried_;
   std::optional<cv::Point2d> last_centre_;
   int frame_ = 0;
