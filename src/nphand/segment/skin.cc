@@ -258,13 +258,16 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     region.centroid = cv::Point2d((found.centroid.x + 0.5) * scale - 0.5, (found.centroid.y + 0.5) * scale - 0.5);
     out.regions.push_back(region);
   }
+  // A region that could hold a face and meets none of the last frame's such regions came
+  // into view (unless the cascade has just looked at it).
   std::vector<cv::Rect> face_sized;
   newcomer_ = false;
   for (const SkinRegion& r : out.regions) {
     if (r.box.width < face_side * scale || r.box.height < face_side * scale) continue;
     face_sized.push_back(r.box);
-    newcomer_ = newcomer_ || (!out.faces_looked && std::none_of(face_sized_.begin(), face_sized_.end(),
-                                          [&](const cv::Rect& before) { return (before & r.box).area() > 0; }));
+    const bool met = std::any_of(face_sized_.begin(), face_sized_.end(),
+                                 [&](const cv::Rect& before) { return (before & r.box).area() > 0; });
+    newcomer_ = newcomer_ || (!out.faces_looked && !met);
   }
   face_sized_ = std::move(face_sized);
   std::sort(out.regions.begin(), out.regions.end(),

@@ -42,8 +42,8 @@ struct SkinOptions {
   // frame after a skin region large enough to hold a face came into view (its box meets no
   // such region's box of the frame before), around those regions, on the frame halved
   // until it is at most 320 pixels wide; between its runs each face found is followed (its
-  // grey look at detection matched around where it was); each face's head and neck are set
-  // aside from the skin.
+  // grey look where it was last seen matched around there); each face's head and neck are
+  // set aside from the skin.
   std::string face_cascade = kDefaultFaceCascade;
   int face_interval = 30;
   bool Check(std::string* why) const;
@@ -63,7 +63,7 @@ struct SkinSegmentation {
   cv::Mat skin;                     // CV_8UC1, working resolution, 255 = skin (cleaned, faces set aside)
   cv::Mat labels;                   // CV_32SC1, working resolution, connected regions of `skin` (0: none)
   std::vector<SkinRegion> regions;  // at least min_area, largest first
-  std::vector<cv::Rect> faces;      // the faces in view (the last detection's), frame pixels
+  std::vector<cv::Rect> faces;      // the faces in view (the last look's, followed since), frame pixels
   int face_pixels = 0;              // frame pixels of skin set aside as faces (heads and necks)
   bool faces_looked = false;        // the face cascade ran on this frame
   // The pixels of the regions labelled `which` within `box` (frame pixels), at the frame's
