@@ -167,6 +167,13 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   constexpr int kMinFace = 24;           // pixels, in the looked-at frame
   const int face_side = kMinFace * look_scale / 2;  // a region's least side that could hold one, working pixels
   const cv::Rect whole(0, 0, work.cols, work.rows);
+  // A face's box (frame pixels) in working pixels; the working pixels within a box, grey.
+  auto working_box = [&](const cv::Rect& r) { return cv::Rect(r.x / scale, r.y / scale, r.width / scale, r.height / scale); };
+  auto grey_of = [&](const cv::Rect& r) {
+    cv::Mat grey;
+    cv::cvtColor(work(r), grey, cv::COLOR_BGR2GRAY);
+    return grey;
+  };
   if (detector_ != nullptr && look) {
     // A face is skin: the cascade looks only around skin regions that could hold one (their
     // box grown by a quarter of a side each way, for the hair and a face cut by a hand).
@@ -182,8 +189,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
           cv::Rect(box.x - box.width / 4, box.y - box.height / 4, box.width * 3 / 2, box.height * 3 / 2) & whole;
       if (std::any_of(looked.begin(), looked.end(), [&](const cv::Rect& r) { return (r & roi) == roi; })) continue;
       looked.push_back(roi);
-      cv::Mat grey;
-      cv::cvtColor(work(roi), grey, cv::COLOR_BGR2GRAY);
+      cv::Mat grey = grey_of(roi);
       for (int h = 0; h < halvings; ++h) cv::pyrDown(grey, grey);
       if (grey.cols < kMinFace || grey.rows < kMinFace) continue;
       cv::equalizeHist(grey, grey);
@@ -199,10 +205,9 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     }
     face_looks_.clear();
     for (const cv::Rect& face : faces_) {
-      const cv::Rect at = cv::Rect(face.x / scale, face.y / scale, face.width / scale, face.height / scale) & whole;
-      cv::Mat grey, looks;
-      cv::cvtColor(work(at), grey, cv::COLOR_BGR2GRAY);
-      cv::resize(grey, looks, cv::Size(kFollowSide, kFollowSide * at.height / std::max(1, at.width)), 0.0, 0.0, cv::INTER_AREA);
+      const cv::Rect at = working_box(face) & whole;
+      cv::Mat looks;
+      cv::resize(grey_of(at), looks, cv::Size(kFollowSide, kFollowSide * at.height / std::max(1, at.width)), 0.0, 0.0, cv::INTER_AREA);
       face_looks_.push_back(looks);
     }
   } else {
@@ -211,12 +216,11 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     // place and look (a turned or nearer face changes its look a little each frame).
     for (size_t i = 0; i < faces_.size(); ++i) {
       cv::Rect& face = faces_[i];
-      const cv::Rect at(face.x / scale, face.y / scale, face.width / scale, face.height / scale);
+      const cv::Rect at = working_box(face);
       const cv::Rect roi = cv::Rect(at.x - at.width, at.y - at.height, at.width * 3, at.height * 3) & whole;
       const double shrink = static_cast<double>(kFollowSide) / at.width;
-      cv::Mat grey, small;
-      cv::cvtColor(work(roi), grey, cv::COLOR_BGR2GRAY);
-      cv::resize(grey, small, cv::Size(), shrink, shrink, cv::INTER_AREA);
+      cv::Mat small;
+      cv::resize(grey_of(roi), small, cv::Size(), shrink, shrink, cv::INTER_AREA);
       const cv::Mat& looks = face_looks_[i];
       if (small.cols < looks.cols || small.rows < looks.rows) continue;
       cv::Mat score;
@@ -234,7 +238,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   if (!faces_.empty()) {
     cv::Mat face_mask = cv::Mat::zeros(work.size(), CV_8UC1);
     for (const cv::Rect& frame_face : faces_) {
-      const cv::Rect f(frame_face.x / scale, frame_face.y / scale, frame_face.width / scale, frame_face.height / scale);
+      const cv::Rect f = working_box(frame_face);
       const cv::Point centre(f.x + f.width / 2, f.y + f.height / 2);
       cv::ellipse(face_mask, centre, cv::Size(f.width * 7 / 10, f.height * 9 / 10), 0, 0, 360, cv::Scalar(255), cv::FILLED);
       cv::rectangle(face_mask, cv::Rect(f.x + f.width / 5, centre.y, f.width * 3 / 5, f.height * 3 / 2), cv::Scalar(255),
