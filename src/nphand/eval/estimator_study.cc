@@ -46,27 +46,27 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     e.sigma_x = 0.5;
     out.push_back({o.name + "-sum0.5", e});
   }
-  for (int carried : {20, 100}) {
+  // The default (the product) with one thing changed.
+  auto around_default = [&](const std::string& name, const auto& change) {
     EstimatorOptions e = base;
     e.prior = PriorCombination::kProduct;
-    e.carried = carried;
-    out.push_back({"carried" + std::to_string(carried), e});
+    change(e);
+    out.push_back({name, e});
+  };
+  for (int carried : {20, 100}) {
+    around_default("carried" + std::to_string(carried), [&](EstimatorOptions& e) { e.carried = carried; });
   }
   // How often the half-turned crop is searched too (its cost: a second descriptor and search).
   for (double ambiguity : {0.0, 0.15, 0.3}) {
-    EstimatorOptions e = base;
-    e.prior = PriorCombination::kProduct;
-    e.roll_ambiguity = ambiguity;
     std::ostringstream name;
     name << "turns" << ambiguity;
-    out.push_back({name.str(), e});
+    around_default(name.str(), [&](EstimatorOptions& e) { e.roll_ambiguity = ambiguity; });
   }
   for (int k : {50, 100}) {
-    EstimatorOptions e = base;
-    e.prior = PriorCombination::kProduct;
-    e.k = k;
-    e.carried = std::min(e.carried, k);
-    out.push_back({"k" + std::to_string(k), e});
+    around_default("k" + std::to_string(k), [&](EstimatorOptions& e) {
+      e.k = k;
+      e.carried = std::min(e.carried, k);
+    });
   }
   return out;
 }
