@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 #include <opencv2/imgproc.hpp>
 
@@ -45,19 +46,14 @@ std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels) {
   const int count = cv::connectedComponents(mask, *labels, 8, CV_32S);
   struct Sums {
     int64_t area = 0, x = 0, y = 0;
-    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
-    cv::Point first;
+    int x0 = std::numeric_limits<int>::max(), x1 = -1, y1 = -1;
+    cv::Point first;  // its first run's first pixel: the box's top row
   };
   std::vector<Sums> sums(count);
   for (const MaskRun& r : runs) {
     Sums& s = sums[labels->at<int>(r.y, r.x0)];  // a run is one region's: its pixels touch
     const int64_t n = r.x1 - r.x0 + 1;
-    if (s.area == 0) {
-      s.x0 = r.x0;
-      s.y0 = r.y;
-      s.x1 = r.x1;
-      s.first = cv::Point(r.x0, r.y);
-    }
+    if (s.area == 0) s.first = cv::Point(r.x0, r.y);
     s.area += n;
     s.x += (static_cast<int64_t>(r.x0) + r.x1) * n / 2;  // x0 + (x0 + 1) + ... + x1
     s.y += r.y * n;
@@ -70,7 +66,7 @@ std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels) {
     const Sums& s = sums[label];
     RegionStats& r = stats[label];
     r.area = static_cast<int>(s.area);
-    r.box = cv::Rect(s.x0, s.y0, s.x1 - s.x0 + 1, s.y1 - s.y0 + 1);
+    r.box = cv::Rect(s.x0, s.first.y, s.x1 - s.x0 + 1, s.y1 - s.first.y + 1);
     r.centroid = cv::Point2d(static_cast<double>(s.x) / s.area, static_cast<double>(s.y) / s.area);
     r.first = s.first;
   }
