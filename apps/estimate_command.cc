@@ -1,8 +1,11 @@
 #include "apps/estimate_command.h"
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
-#include <fstream>
+#include <optional>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -14,6 +17,7 @@
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
 #include "nphand/util/progress.h"
+#include "nphand/util/text.h"
 
 namespace nphand {
 namespace {
@@ -54,7 +58,109 @@ cv::Mat Overlay(const cv::Mat& frame, const FrameResult& result, Estimator* esti
 
 }  // namespace
 
-nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* progress, const std::atomic<bool>* stop) {
+namespace {
+
+// `picture` scaled to fit `size` with its aspect kept, on a dark border: an overlay video
+// has one frame size, and a folder's images may differ.
+cv::Mat FitInto(const cv::Mat& picture, cv::Size size) {
+  if (picture.size() == size) return picture;
+  const double scale = std::min(static_cast<double>(size.width) / picture.cols, static_cast<double>(size.height) / picture.rows);
+  const cv::Size fitted(std::max(1, static_cast<int>(picture.cols * scale)), std::max(1, static_cast<int>(picture.rows * scale)));
+  cv::Mat out(size, CV_8UC3, cv::Scalar(32, 32, 32));
+  cv::resize(picture, out(cv::Rect((size.width - fitted.width) / 2, (size.height - fitted.height) / 2, fitted.width, fitted.height)),
+             fitted, 0, 0, cv::INTER_AREA);
+  return out;
+}
+
+// The overlay's frame for an image that could not be read: grey, with why.
+cv::Mat UnreadablePicture(cv::Size size, const std::string& reason) {
+  cv::Mat picture(size, CV_8UC3, cv::Scalar(64, 64, 64));
+  cv::putText(picture, "unreadable: " + reason.substr(0, 60), cv::Point(8, size.height / 2), cv::FONT_HERSHEY_SIMPLEX,
+              std::max(0.4, size.height / 960.0) * 0.5, cv::Scalar(80, 80, 255), 1, cv::LINE_AA);
+  return picture;
+}
+
+// The overlay video, written under "<path>.partial.mp4" (locked against a second run), its
+// frame size that of the first picture; every later picture is fitted into it, so that the
+// video keeps one frame per line. Finish() checks what reached the disk before renaming.
+class OverlayWriter {
+ public:
+  OverlayWriter(const std::filesystem::path& path, double fps)
+      : path_(path), partial_(path.string() + ".partial.mp4"), lock_(File::OpenLocked(partial_)), fps_(fps) {
+    lock_.Truncate(0);
+  }
+  ~OverlayWriter() {
+    if (done_) return;
+    video_.release();
+    std::error_code ec;
+    std::filesystem::remove(partial_, ec);
+  }
+  // Sets the frame size if this is the first picture.
+  void Size(cv::Size size) {
+    if (size_.area() == 0) size_ = size;
+  }
+  cv::Size size() const { return size_; }
+  void Write(const cv::Mat& picture) {
+    Size(picture.size());
+    if (!video_.isOpened()) {
+      video_.open(partial_.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps_, size_);
+      NPHAND_THROW_CHECK(video_.isOpened(), partial_.string(), ": cannot open a video writer (MPEG-4)");
+    }
+    video_.write(FitInto(picture, size_));
+    ++frames_;
+  }
+  uint64_t frames() const { return frames_; }
+  // OpenCV's writer reports no failed write (a full disk), so the finished file is read back:
+  // it must open and hold every frame written.
+  void Finish() {
+    video_.release();
+    cv::VideoCapture check(partial_.string(), cv::CAP_FFMPEG);
+    const double held = check.isOpened() ? check.get(cv::CAP_PROP_FRAME_COUNT) : 0.0;
+    check.release();
+    NPHAND_THROW_CHECK(held == static_cast<double>(frames_), path_.string(), ": the overlay video is damaged: ",
+                       partial_.string(), " holds ", static_cast<uint64_t>(held), " of the ", frames_,
+                       " frames written (is the disk full?); it was removed");
+    std::error_code ec;
+    std::filesystem::rename(partial_, path_, ec);
+    NPHAND_THROW_CHECK(!ec, path_.string(), ": cannot rename ", partial_.string(), " into place (", ec.message(), ")");
+    done_ = true;
+  }
+
+ private:
+  std::filesystem::path path_, partial_;
+  File lock_;
+  double fps_;
+  cv::VideoWriter video_;
+  cv::Size size_;
+  uint64_t frames_ = 0;
+  bool done_ = false;
+};
+
+// Every file a run reads: refused as an output.
+std::vector<NamedPath> Inputs(const EstimateCommandOptions& options, const std::filesystem::path& index_path,
+                              const FrameSource& source) {
+  std::vector<NamedPath> inputs = {{options.db, "--db"},
+                                   {index_path, "--index"},
+                                   {options.asset_dir / "right.glb", "the hand asset"},
+                                   {options.asset_dir / "left.glb", "the hand asset"}};
+  if (source.kind() == "video") inputs.push_back({options.input, "--input"});
+  for (const std::filesystem::path& image : source.images()) inputs.push_back({image, "an image of --input"});
+  if (options.faces) inputs.push_back({options.estimator.skin.face_cascade, "the face cascade"});
+  return inputs;
+}
+
+}  // namespace
+
+const char* SignalName(int signal) {
+  switch (signal) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    default: return "a signal";
+  }
+}
+
+nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* progress, const std::atomic<int>* stop) {
   EstimatorOptions estimator_options = options.estimator;
   estimator_options.hand = HandednessFromString(options.hand);
   estimator_options.observation = ObservationWeightFromString(options.observation);
@@ -63,7 +169,13 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   std::string why;
   NPHAND_THROW_CHECK(estimator_options.Check(&why), "estimate: ", why);
   CheckOutputFile(options.out, "--out");
-  if (!options.overlay.empty()) CheckOutputFile(options.overlay, "--overlay");
+  if (!options.overlay.empty()) {
+    CheckOutputFile(options.overlay, "--overlay");
+    std::string extension = options.overlay.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+    NPHAND_THROW_CHECK(extension == ".mp4", "--overlay '", options.overlay.string(),
+                       "': nphand writes the overlay as MPEG-4; name it .mp4");
+  }
   const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
   std::error_code error;
   NPHAND_THROW_CHECK(std::filesystem::exists(options.db, error), options.db.string(),
@@ -71,71 +183,110 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   NPHAND_THROW_CHECK(std::filesystem::exists(index_path, error), index_path.string(),
                      ": no index there (make one with `nphand index build --db ", options.db.string(), "`)");
   FrameSource source(options.input, options.fps);
+  std::vector<NamedPath> outputs = {{options.out, "--out"}};
+  if (!options.overlay.empty()) outputs.push_back({options.overlay, "--overlay"});
+  CheckOutputsApart(Inputs(options, index_path, source), outputs);
+
+  // The outputs are taken (locked) before the long load, so that a second run into them is
+  // refused at once; their final names are replaced only when the run has frames to show.
+  LineFile lines(options.out);
+  std::optional<OverlayWriter> overlay;
+  if (!options.overlay.empty()) overlay.emplace(options.overlay, source.fps());
 
   const Database db = Database::Open(options.db);
   const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
   Estimator estimator(db, *index, hand, estimator_options);
 
-  // Lines go to a partial file as they come; a stop or an error still leaves whole lines,
-  // and the finished file takes the final name.
-  const std::filesystem::path partial = options.out.string() + ".partial";
-  std::ofstream out(partial, std::ios::binary | std::ios::trunc);
-  NPHAND_THROW_CHECK(out.good(), partial.string(), ": cannot write");
-  cv::VideoWriter video;
-  const std::filesystem::path video_partial = options.overlay.string() + ".partial.mp4";
-
   const uint64_t total = options.max_frames > 0 && source.count() > 0 ? std::min(options.max_frames, source.count())
                          : options.max_frames > 0                      ? options.max_frames
                                                                        : source.count();
   ProgressLine line(progress, "estimate", total, "frames");
-  uint64_t frames = 0, detected = 0;
+  uint64_t frames = 0, detected = 0, unreadable = 0, damaged = 0;
   double estimate_ms = 0.0;
-  bool stopped = false;
+  int signal = 0;
+  bool input_ended = false;
+  std::vector<std::string> unreadable_reasons;  // of frames before the overlay's size is known
   const auto start = std::chrono::steady_clock::now();
-  while (options.max_frames == 0 || frames < options.max_frames) {
-    if (stop != nullptr && stop->load()) {
-      stopped = true;
-      break;
-    }
-    std::optional<Frame> frame = source.Next();
-    if (!frame.has_value()) break;
-    const FrameResult result = estimator.Process(frame->bgr, frame->time_s);
-    nlohmann::json json = FrameResultJson(result, db, options.top);
-    if (!frame->name.empty()) json["image"] = frame->name;
-    out << json.dump() << '\n';
-    out.flush();
-    NPHAND_THROW_CHECK(out.good(), partial.string(), ": write failed (disk full?)");
-    if (!options.overlay.empty()) {
-      const cv::Mat picture = Overlay(frame->bgr, result, &estimator, db);
-      if (!video.isOpened()) {
-        video.open(video_partial.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), source.fps(), picture.size());
-        NPHAND_THROW_CHECK(video.isOpened(), video_partial.string(), ": cannot open a video writer (MPEG-4)");
+  try {
+    while (options.max_frames == 0 || frames < options.max_frames) {
+      if (stop != nullptr && (signal = stop->load()) != 0) break;
+      std::optional<Frame> frame = source.Next();
+      if (!frame.has_value()) {
+        input_ended = true;
+        break;
       }
-      video.write(picture);
+      nlohmann::json json;
+      if (!frame->error.empty()) {
+        json = {{"frame", frames}, {"time_s", frame->time_s}, {"detected", false}, {"status", "unreadable"},
+                {"reason", frame->error}};
+        ++unreadable;
+        if (overlay.has_value() && overlay->frames() > 0) {
+          overlay->Write(UnreadablePicture(overlay->size(), frame->error));
+        } else if (overlay.has_value()) {
+          unreadable_reasons.push_back(frame->error);
+        }
+      } else {
+        const FrameResult result = estimator.Process(frame->bgr, frame->time_s);
+        json = FrameResultJson(result, db, options.top);
+        json["frame"] = frames;  // the input's numbering, unreadable frames included
+        detected += result.detected();
+        estimate_ms += result.ms.total;
+        if (overlay.has_value()) {
+          const cv::Mat picture = Overlay(frame->bgr, result, &estimator, db);
+          overlay->Size(picture.size());
+          for (const std::string& reason : unreadable_reasons) overlay->Write(UnreadablePicture(overlay->size(), reason));
+          unreadable_reasons.clear();
+          overlay->Write(picture);
+        }
+      }
+      if (!frame->name.empty()) json["image"] = frame->name;
+      if (!frame->warnings.empty()) {
+        json["warnings"] = frame->warnings;
+        ++damaged;
+      }
+      lines.Write(json.dump());
+      ++frames;
+      if (total > 0) line.Update(std::min(frames, total));
     }
-    ++frames;
-    detected += result.detected();
-    estimate_ms += result.ms.total;
-    if (total > 0) line.Update(std::min(frames, total));
-  }
-  line.Finish();
-  out.close();
-  std::filesystem::rename(partial, options.out);
-  if (video.isOpened()) {
-    video.release();
-    std::filesystem::rename(video_partial, options.overlay);
+    line.Finish();
+    if (frames > 0) {
+      // The poses first: a damaged overlay must not cost them.
+      lines.Commit();
+      if (overlay.has_value() && overlay->frames() > 0) overlay->Finish();
+    }
+  } catch (const Error& e) {
+    if (frames == 0) throw;
+    if (lines.committed()) throw Error(std::string(e.what()) + " (the poses are complete in " + options.out.string() + ")");
+    lines.Keep();
+    throw Error(std::string(e.what()) + " (the " + std::to_string(lines.lines()) + " whole lines written are in " +
+                lines.partial().string() + ")");
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  nlohmann::json summary = {{"input", options.input},
+  nlohmann::json summary = {{"input", Utf8OrEscaped(options.input)},
                             {"input_kind", source.kind()},
                             {"frames", frames},
                             {"detected", detected},
-                            {"stopped", stopped},
+                            {"unreadable", unreadable},
+                            {"damaged", damaged},
+                            {"stopped", signal != 0},
                             {"seconds", seconds},
-                            {"estimate_ms_mean", frames > 0 ? estimate_ms / frames : 0.0},
-                            {"out", options.out.string()}};
-  if (!options.overlay.empty() && frames > 0) summary["overlay"] = options.overlay.string();
+                            {"estimate_ms_mean", frames - unreadable > 0 ? estimate_ms / (frames - unreadable) : 0.0}};
+  if (signal != 0) summary["signal"] = SignalName(signal);
+  // A video that ends before the frames its container promised was cut short.
+  const bool truncated = input_ended && source.kind() == "video" && source.count() > source.read();
+  summary["input_complete"] = !truncated;
+  if (source.count() > 0) summary["frames_expected"] = source.count();
+  if (truncated && progress != nullptr) {
+    *progress << "estimate: warning: " << Utf8OrEscaped(options.input) << " ended after " << source.read()
+              << " frames, but its container promised " << source.count() << ": the video is truncated or damaged\n";
+  }
+  if (frames > 0) {
+    summary["out"] = Utf8OrEscaped(options.out.string());
+    if (overlay.has_value() && overlay->frames() > 0) summary["overlay"] = Utf8OrEscaped(options.overlay.string());
+  } else {
+    summary["out"] = nullptr;
+  }
   return summary;
 }
 

@@ -1,6 +1,6 @@
 // `nphand estimate`: hand poses for every frame of a video, an image folder or a camera,
 // one JSON line per frame (docs/FORMAT.md), optionally an overlay video; progress on
-// files; Ctrl-C stops after the current frame and leaves complete files.
+// files; Ctrl-C, SIGTERM and SIGHUP stop after the current frame and leave complete files.
 #pragma once
 
 #include <atomic>
@@ -32,8 +32,15 @@ struct EstimateCommandOptions {
   std::filesystem::path asset_dir = DefaultAssetDir();
 };
 
-// Runs the estimator over the input. `stop` (if not null) is polled between frames: when it
-// turns true the run ends cleanly. Returns a summary (frames, detected, fps, files).
-nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* progress, const std::atomic<bool>* stop);
+// Runs the estimator over the input (docs/FORMAT.md says what each ending leaves). Before any
+// work, an output that is an input or another output is refused, and so is a second run
+// into the same outputs. `stop` (if not null) is polled between frames: when it holds a
+// signal number the run ends cleanly after the current frame. Returns a summary (frames,
+// detected, unreadable, stopped and by which signal, whether the input was whole, files).
+// A run stopped before its first frame replaces nothing ("out" is null).
+nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* progress, const std::atomic<int>* stop);
+
+// "SIGINT", "SIGTERM", "SIGHUP".
+const char* SignalName(int signal);
 
 }  // namespace nphand

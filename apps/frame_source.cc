@@ -6,6 +6,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "nphand/util/check.h"
+#include "nphand/util/io.h"
+#include "nphand/util/text.h"
 
 namespace nphand {
 namespace {
@@ -14,6 +16,37 @@ bool IsImage(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" || ext == ".tiff";
+}
+
+// A JPEG ends with its end-of-image marker (FF D9). One cut short still decodes (libjpeg
+// fills the rest grey and only warns on stderr), so it is checked here.
+bool JpegEndsWhole(const std::vector<uint8_t>& bytes) {
+  size_t end = bytes.size();
+  while (end > 0 && bytes[end - 1] == 0) --end;  // padding after the marker
+  return end >= 4 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[end - 2] == 0xFF && bytes[end - 1] == 0xD9;
+}
+
+// Reads and decodes one image of a folder into `frame`, or says why it cannot.
+void ReadImage(const std::filesystem::path& path, Frame* frame) {
+  std::vector<uint8_t> bytes;
+  try {
+    bytes = ReadFileBytes(path);
+  } catch (const Error& e) {
+    frame->error = Utf8OrEscaped(e.what());
+    return;
+  }
+  if (bytes.empty()) {
+    frame->error = "the file is empty";
+    return;
+  }
+  frame->bgr = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  if (frame->bgr.empty()) {
+    frame->error = "cannot decode this image (truncated, damaged or not an image)";
+    return;
+  }
+  if (bytes.size() >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8 && !JpegEndsWhole(bytes)) {
+    frame->warnings.push_back("truncated JPEG: no end-of-image marker, so the lower part of the image is missing");
+  }
 }
 
 }  // namespace
@@ -64,9 +97,12 @@ std::optional<Frame> FrameSource::Next() {
   if (kind_ == "folder") {
     if (next_ >= images_.size()) return std::nullopt;
     const std::filesystem::path& path = images_[next_];
-    frame.bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
-    NPHAND_THROW_CHECK(!frame.bgr.empty(), path.string(), ": cannot read this image");
-    frame.name = path.filename().string();
+    frame.name = Utf8OrEscaped(path.filename().string());
+    ReadImage(path, &frame);
+    if (!frame.error.empty()) {
+      ++next_;
+      return frame;
+    }
   } else {
     if (!capture_.read(frame.bgr) || frame.bgr.empty()) {
       // A video that gives not even its first frame is not a video.

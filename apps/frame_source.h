@@ -1,5 +1,6 @@
 // Where `nphand estimate` reads frames: a video file, a folder of images (in name order) or
-// a camera (its index). Each gives a clear one-line error when it cannot be read.
+// a camera (its index). Each gives a clear one-line error when it cannot be opened; an
+// image of a folder that cannot be read is one frame with an error, not the end of the run.
 #pragma once
 
 #include <filesystem>
@@ -14,9 +15,11 @@
 namespace nphand {
 
 struct Frame {
-  cv::Mat bgr;
+  cv::Mat bgr;  // empty when `error` is set
   double time_s = 0.0;
-  std::string name;  // the image's file name, for folders
+  std::string name;                   // the image's file name, for folders (not UTF-8: escaped)
+  std::string error;                  // why the frame could not be read (a folder's image)
+  std::vector<std::string> warnings;  // read, but damaged (a truncated JPEG)
 };
 
 class FrameSource {
@@ -25,11 +28,15 @@ class FrameSource {
   // the frames of a folder (a video and a camera time their own). Throws nphand::Error when
   // the input is missing, not readable, an empty folder or a camera that is not there.
   FrameSource(const std::string& input, double fps);
-  // The next frame, or nothing at the end. Throws nphand::Error for an image that cannot
-  // be read (naming it).
+  // The next frame, or nothing at the end. A folder's image that cannot be read or decoded
+  // gives a frame with `error` set (naming why) and the folder goes on.
   std::optional<Frame> Next();
-  // Frames in all, if known (folders, most videos); 0 otherwise.
+  // Frames in all, if known (folders, most videos: what the container says); 0 otherwise.
   uint64_t count() const { return count_; }
+  // Frames given so far.
+  uint64_t read() const { return next_; }
+  // Every image of a folder, in order; empty for a video or a camera.
+  const std::vector<std::filesystem::path>& images() const { return images_; }
   double fps() const { return fps_; }
   const std::string& kind() const { return kind_; }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+
+#include <signal.h>
 #include <cstdio>
 #include <iostream>
 
@@ -105,7 +107,19 @@ void AddSequenceCommand(CLI::App& app, nphand::SequenceCommandOptions& o) {
   });
 }
 
-std::atomic<bool> g_stop{false};
+// The signal that asked a long job to stop (0: none), and the exit status main returns.
+std::atomic<int> g_stop{0};
+int g_exit_status = 0;
+
+// Ctrl-C, `kill`/`timeout` (SIGTERM) and a closed terminal (SIGHUP) ask the job to stop
+// after its current frame; a second such signal ends the process at once.
+void CatchStopSignals() {
+  struct sigaction action {};
+  action.sa_handler = [](int signal) { g_stop = signal; };
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  for (int signal : {SIGINT, SIGTERM, SIGHUP}) sigaction(signal, &action, nullptr);
+}
 
 void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   CLI::App* cmd = app.add_subcommand("estimate", "Estimate the hand's 3D pose in every frame of a video, image folder or camera");
@@ -139,11 +153,16 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--max-frames", o.max_frames, "Stop after this many frames (0: all)")->capture_default_str();
   cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   cmd->callback([&o]() {
-    // Ctrl-C ends the run after the current frame, with complete files.
-    std::signal(SIGINT, [](int) { g_stop = true; });
+    // A stop signal ends the run after the current frame, with complete files, and the
+    // status says it was stopped: 128 + the signal's number (130 for Ctrl-C).
+    CatchStopSignals();
     const nlohmann::json summary = nphand::RunEstimate(o, &std::cerr, &g_stop);
-    std::signal(SIGINT, SIG_DFL);
     std::cout << summary.dump(2) << "\n";
+    if (summary["stopped"].get<bool>()) {
+      std::cerr << "estimate: stopped by " << nphand::SignalName(g_stop) << " after " << summary["frames"] << " frames"
+                << (summary["out"].is_null() ? "; nothing was written" : "") << "\n";
+      g_exit_status = 128 + g_stop;
+    }
   });
 }
 
@@ -493,5 +512,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "nphand: error: %s\n", e.what());
     return 1;
   }
-  return 0;
+  return g_exit_status;
 }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <csignal>
 #include <fstream>
 #include <set>
 
@@ -121,11 +122,14 @@ TEST_F(EstimateCommandTest, AStopLeavesCompleteLinesAndMaxFramesStops) {
   options.max_frames = 2;
   EXPECT_EQ(RunEstimate(options, nullptr, nullptr)["frames"], 2);
   EXPECT_EQ(Lines(options.out).size(), 2u);
-  const std::atomic<bool> stop{true};
+  // Stopped before its first frame (while loading): the last run's file stays as it was.
+  const std::atomic<int> stop{SIGINT};
   const nlohmann::json summary = RunEstimate(Options(), nullptr, &stop);
   EXPECT_TRUE(summary["stopped"].get<bool>());
-  EXPECT_TRUE(std::filesystem::exists(Options().out));
-  EXPECT_TRUE(Lines(Options().out).empty());
+  EXPECT_EQ(summary["signal"], "SIGINT");
+  EXPECT_TRUE(summary["out"].is_null());
+  EXPECT_EQ(Lines(Options().out).size(), 2u);
+  EXPECT_FALSE(std::filesystem::exists(Options().out.string() + ".partial"));
 }
 
 TEST_F(EstimateCommandTest, BadInputsGiveTheirErrors) {

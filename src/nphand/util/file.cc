@@ -1,5 +1,6 @@
 #include "nphand/util/file.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <utility>
@@ -136,6 +137,105 @@ void CheckOutputFolder(const std::filesystem::path& path, const std::string& wha
   NPHAND_THROW_CHECK(std::filesystem::is_directory(path, ec), what, " '", path.string(), "': is a file, not a folder");
   NPHAND_THROW_CHECK(::access(path.c_str(), W_OK | X_OK) == 0, what, " '", path.string(),
                      "': cannot write in this folder (", std::strerror(errno), ")");
+}
+
+namespace {
+
+// The file `path` reaches, as far as it exists: its device and inode when it does,
+// otherwise its absolute path with symlinks and "." and ".." resolved.
+struct Identity {
+  bool exists = false;
+  dev_t device = 0;
+  ino_t inode = 0;
+  std::filesystem::path resolved;
+  bool operator==(const Identity& other) const {
+    return exists == other.exists && (exists ? device == other.device && inode == other.inode : resolved == other.resolved);
+  }
+};
+
+Identity IdentityOf(const std::filesystem::path& path) {
+  Identity identity;
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0) {
+    identity.exists = true;
+    identity.device = info.st_dev;
+    identity.inode = info.st_ino;
+    return identity;
+  }
+  std::error_code ec;
+  identity.resolved = std::filesystem::weakly_canonical(std::filesystem::absolute(path, ec), ec);
+  if (ec) identity.resolved = std::filesystem::absolute(path).lexically_normal();
+  return identity;
+}
+
+std::string Describe(const NamedPath& named) { return named.what + " '" + named.path.string() + "'"; }
+
+}  // namespace
+
+void CheckOutputsApart(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs) {
+  std::vector<Identity> output_ids;
+  for (const NamedPath& output : outputs) output_ids.push_back(IdentityOf(output.path));
+  for (size_t o = 0; o < outputs.size(); ++o) {
+    for (size_t p = 0; p < o; ++p) {
+      NPHAND_THROW_CHECK(!(output_ids[o] == output_ids[p]), Describe(outputs[o]), " and ", Describe(outputs[p]),
+                         " are the same file: one output would overwrite the other");
+    }
+  }
+  for (const NamedPath& input : inputs) {
+    if (input.path.empty()) continue;
+    const Identity id = IdentityOf(input.path);
+    const Identity folder = IdentityOf(input.path.has_parent_path() ? input.path.parent_path() : ".");
+    const std::string extension = input.path.extension().string();
+    for (size_t o = 0; o < outputs.size(); ++o) {
+      const NamedPath& output = outputs[o];
+      if (output.extensions.empty()) {
+        NPHAND_THROW_CHECK(!(id == output_ids[o]), Describe(output), " is ", Describe(input),
+                           ": writing it would destroy an input; write elsewhere");
+      } else {
+        const bool written_here = std::find(output.extensions.begin(), output.extensions.end(), extension) !=
+                                  output.extensions.end();
+        NPHAND_THROW_CHECK(!written_here || !(folder == output_ids[o]), Describe(input), " lies in ", Describe(output),
+                           ", where this command writes its ", extension,
+                           " files: writing there could destroy an input; write elsewhere");
+      }
+    }
+  }
+}
+
+LineFile::LineFile(std::filesystem::path path) : path_(std::move(path)), file_(File::OpenLocked(path_.string() + ".partial")) {
+  file_.Truncate(0);
+}
+
+LineFile::~LineFile() {
+  if (done_ || keep_) return;
+  std::error_code ec;
+  std::filesystem::remove(file_.path(), ec);
+}
+
+void LineFile::Write(std::string_view line) {
+  std::string bytes;
+  bytes.reserve(line.size() + 1);
+  bytes.append(line).push_back('\n');
+  try {
+    file_.WriteAt(size_, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
+  } catch (const Error&) {
+    // Whole lines only: what part of this line reached the disk goes again.
+    if (::ftruncate(file_.fd(), static_cast<off_t>(size_)) == 0) throw;
+    NPHAND_THROW(file_.path().string(), ": a write failed and its cut-off last line could not be removed (",
+                 std::strerror(errno), ")");
+  }
+  size_ += bytes.size();
+  ++lines_;
+}
+
+void LineFile::Commit() {
+  NPHAND_CHECK(!done_, "a LineFile is committed once");
+  file_.Sync();
+  std::error_code ec;
+  std::filesystem::rename(file_.path(), path_, ec);
+  NPHAND_THROW_CHECK(!ec, path_.string(), ": cannot rename ", file_.path().string(), " into place (", ec.message(), ")");
+  done_ = true;
+  file_.Close();
 }
 
 void CheckFileName(const std::string& name, const std::string& what) {

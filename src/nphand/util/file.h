@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace nphand {
 
@@ -56,6 +58,49 @@ void CheckOutputFile(const std::filesystem::path& path, const std::string& what)
 // The same for an output folder: created if missing, refused if it is a file or not
 // writable.
 void CheckOutputFolder(const std::filesystem::path& path, const std::string& what);
+// A path a command reads or writes, with the option that names it in messages ("--db").
+// An output folder (`extensions` not empty) stands for the files of those extensions
+// (".json", ".png") the command writes into it.
+struct NamedPath {
+  std::filesystem::path path;
+  std::string what;
+  std::vector<std::string> extensions = {};
+};
+
+// Refuses, before any work, an output that is an input or another output: paths are
+// compared as the files they reach (symlinks, "..", "." and hard links resolved). An input
+// inside an output folder with one of the extensions written there is refused too. Throws
+// nphand::Error naming both options and the file.
+void CheckOutputsApart(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
+
+// A text file written line by line under "<path>.partial", locked against other writers
+// (a second writer is refused by name, and nothing of the first's is touched), holding only
+// whole lines: a line whose write fails (a full disk) is cut off again before the error is
+// thrown. Commit() renames it to `path`; a writer dropped uncommitted removes its partial
+// file, unless Keep() was called.
+class LineFile {
+ public:
+  explicit LineFile(std::filesystem::path path);
+  ~LineFile();
+  LineFile(const LineFile&) = delete;
+  LineFile& operator=(const LineFile&) = delete;
+
+  // Appends `line` and a newline. Throws naming the partial file when the write fails.
+  void Write(std::string_view line);
+  void Commit();
+  // Leaves the partial file in place (with its whole lines) when the writer is dropped.
+  void Keep() { keep_ = true; }
+  bool committed() const { return done_; }
+  const std::filesystem::path& partial() const { return file_.path(); }
+  uint64_t lines() const { return lines_; }
+
+ private:
+  std::filesystem::path path_;
+  File file_;
+  uint64_t size_ = 0, lines_ = 0;
+  bool done_ = false, keep_ = false;
+};
+
 // Checks that `name` is a plain file name (no folder part, not "." or "..", not empty), so
 // that files written under an output folder stay in it.
 void CheckFileName(const std::string& name, const std::string& what);

@@ -4,13 +4,6 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <memory>
-
-#include <fcntl.h>
-#include <unistd.h>
 
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
@@ -25,32 +18,21 @@ std::vector<uint8_t> ReadFileBytes(const std::filesystem::path& path) {
 }
 
 void WriteFileAtomic(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+  // The temporary file is locked: a second writer of the same path is refused by name
+  // instead of writing into the first one's bytes.
   const std::filesystem::path tmp = path.string() + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  NPHAND_THROW_CHECK(fd >= 0, tmp.string(), ": cannot open for writing (", std::strerror(errno), ")");
-  size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int saved = errno;
-      ::close(fd);
-      std::filesystem::remove(tmp);
-      NPHAND_THROW(tmp.string(), ": write failed (", std::strerror(saved), ")");
-    }
-    written += static_cast<size_t>(n);
-  }
-  const bool synced = ::fsync(fd) == 0;
-  const bool closed = ::close(fd) == 0;
-  if (!synced || !closed) {
-    std::filesystem::remove(tmp);
-    NPHAND_THROW(tmp.string(), ": flush failed (", std::strerror(errno), ")");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp);
-    NPHAND_THROW(path.string(), ": cannot rename the temporary file into place (", ec.message(), ")");
+  File file = File::OpenLocked(tmp);
+  try {
+    file.Truncate(0);
+    file.WriteAt(0, bytes);
+    file.Sync();
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    NPHAND_THROW_CHECK(!ec, path.string(), ": cannot rename the temporary file into place (", ec.message(), ")");
+  } catch (const Error&) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
   }
 }
 
