@@ -34,6 +34,7 @@ nlohmann::json RunDbBuild(DbBuildCommandOptions options) {
   std::string why;
   NPHAND_THROW_CHECK(options.build.Check(&why), "db build: ", why);
   CheckOutputFile(options.out, "db build --out");
+  CheckOutputsApart({{options.asset_dir / "right.glb", "the hand asset"}}, {{options.out, "db build --out"}});
   std::string reuse_note;
   std::error_code error;
   if (options.reuse && std::filesystem::exists(options.out, error)) {
@@ -55,6 +56,9 @@ nlohmann::json RunDbBuild(DbBuildCommandOptions options) {
 }
 
 nlohmann::json RunDbMerge(const std::vector<std::filesystem::path>& shards, const std::filesystem::path& out) {
+  std::vector<NamedPath> inputs;
+  for (const std::filesystem::path& shard : shards) inputs.push_back({shard, "a shard"});
+  CheckOutputsApart(inputs, {{out, "db merge --out"}});
   MergeDatabases(shards, out);
   return DescribeDatabase(Database::Open(out));
 }

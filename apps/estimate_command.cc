@@ -169,13 +169,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   std::string why;
   NPHAND_THROW_CHECK(estimator_options.Check(&why), "estimate: ", why);
   CheckOutputFile(options.out, "--out");
-  if (!options.overlay.empty()) {
-    CheckOutputFile(options.overlay, "--overlay");
-    std::string extension = options.overlay.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
-    NPHAND_THROW_CHECK(extension == ".mp4", "--overlay '", options.overlay.string(),
-                       "': nphand writes the overlay as MPEG-4; name it .mp4");
-  }
+  if (!options.overlay.empty()) CheckOutputFile(options.overlay, "--overlay");
   const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
   std::error_code error;
   NPHAND_THROW_CHECK(std::filesystem::exists(options.db, error), options.db.string(),
@@ -186,6 +180,12 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   std::vector<NamedPath> outputs = {{options.out, "--out"}};
   if (!options.overlay.empty()) outputs.push_back({options.overlay, "--overlay"});
   CheckOutputsApart(Inputs(options, index_path, source), outputs);
+  if (!options.overlay.empty()) {
+    std::string extension = options.overlay.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+    NPHAND_THROW_CHECK(extension == ".mp4", "--overlay '", options.overlay.string(),
+                       "': nphand writes the overlay as MPEG-4; name it .mp4");
+  }
 
   // The outputs are taken (locked) before the long load, so that a second run into them is
   // refused at once; their final names are replaced only when the run has frames to show.

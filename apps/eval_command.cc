@@ -10,11 +10,23 @@
 #include "nphand/util/system.h"
 
 namespace nphand {
+namespace {
+
+// The files "<dir>/<name><extension>" a study writes, for CheckOutputsApart.
+std::vector<NamedPath> NamedOutputs(const std::filesystem::path& dir, const std::string& name,
+                                    const std::vector<std::string>& extensions) {
+  std::vector<NamedPath> outputs;
+  for (const std::string& extension : extensions) outputs.push_back({dir / (name + extension), "--out"});
+  return outputs;
+}
+
+}  // namespace
 
 FeatureStudyResult RunEvalFeatures(const EvalFeaturesCommandOptions& options) {
   if (!options.out_dir.empty()) {
     CheckFileName(options.name, "eval features --name");
     CheckOutputFolder(options.out_dir, "eval features --out");
+    CheckOutputsApart({{options.db, "--db"}}, NamedOutputs(options.out_dir, options.name, {".json", ".png"}));
   }
   const Database db = Database::Open(options.db);
   const FeatureStudyResult result = RunFeatureStudy(db, options.study, options.quiet ? nullptr : &std::cerr);
@@ -31,6 +43,7 @@ AnnStudyResult RunEvalAnn(const EvalAnnCommandOptions& options) {
   if (!options.out_dir.empty()) {
     CheckFileName(options.name, "eval ann --name");
     CheckOutputFolder(options.out_dir, "eval ann --out");
+    CheckOutputsApart({{options.db, "--db"}}, NamedOutputs(options.out_dir, options.name, {".json", ".png"}));
   }
   const Database db = Database::Open(options.db);
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
@@ -46,6 +59,8 @@ PoseErrorSummary RunEvalPoses(const EvalPosesCommandOptions& options) {
   if (!options.out_dir.empty()) {
     CheckFileName(options.name, "eval poses --name");
     CheckOutputFolder(options.out_dir, "eval poses --out");
+    CheckOutputsApart({{options.truth, "--truth"}, {options.poses, "--poses"}},
+                      NamedOutputs(options.out_dir, options.name, {".json", ".png"}));
   }
   const PoseErrorSummary summary = ComparePoses(options.truth, options.poses);
   if (!options.out_dir.empty()) {
@@ -64,6 +79,9 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
     CheckOutputFolder(options.out_dir, "eval estimator --out");
   }
   const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+  if (!options.out_dir.empty()) {
+    CheckOutputsApart({{options.db, "--db"}, {index_path, "--index"}}, NamedOutputs(options.out_dir, options.name, {".json"}));
+  }
   const Database db = Database::Open(options.db);
   const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
@@ -101,7 +119,10 @@ struct LoadedStudy {
   static Database Open(const EvalPoseStudyCommandOptions& options, const std::string& command) {
     std::string why;
     NPHAND_THROW_CHECK(options.study.Check(&why), command, ": ", why);
-    if (!options.out_dir.empty()) CheckOutputFolder(options.out_dir, command + " --out");
+    if (!options.out_dir.empty()) {
+      CheckOutputFolder(options.out_dir, command + " --out");
+      CheckOutputsApart({{options.db, "--db"}, {IndexPath(options), "--index"}}, {{options.out_dir, command + " --out", {".json", ".png"}}});
+    }
     return Database::Open(options.db);
   }
   Database db;

@@ -13,6 +13,7 @@ nlohmann::json RunIndexBuild(const IndexBuildCommandOptions& options) {
   NPHAND_THROW_CHECK(options.index.Check(&why), "index build: ", why);
   const std::filesystem::path out = options.out.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.out;
   CheckOutputFile(out, "index build --out");
+  CheckOutputsApart({{options.db, "--db"}}, {{out, "index build --out"}});
   const auto start = std::chrono::steady_clock::now();
   const Database db = Database::Open(options.db);
   std::string reuse_note;

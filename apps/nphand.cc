@@ -2,6 +2,7 @@
 // the fields of an options struct and calls the matching Run* function.
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <csignal>
 
 #include <signal.h>
@@ -27,6 +28,16 @@ std::string CommaList(const std::vector<std::string>& names) {
   std::string list;
   for (const std::string& name : names) list += (list.empty() ? "" : ", ") + name;
   return list;
+}
+
+// For options held in unsigned fields, which would take "-1" as a huge number.
+CLI::Validator WholeNumber() {
+  return CLI::Validator(
+      [](std::string& item) {
+        const bool digits = !item.empty() && std::all_of(item.begin(), item.end(), [](unsigned char c) { return std::isdigit(c); });
+        return digits ? std::string() : "'" + item + "' is not a whole number (0 or more)";
+      },
+      "", "whole number");
 }
 
 void AddGraspCheck(CLI::Option* option) {
@@ -95,7 +106,7 @@ void AddSequenceCommand(CLI::App& app, nphand::SequenceCommandOptions& o) {
   cmd->add_option("--distance", s.distance_m, "Camera to hand, metres (average)")->capture_default_str();
   cmd->add_option("--noise", s.noise, "Sensor noise, standard deviation in 8-bit levels")->capture_default_str();
   cmd->add_option("--hand", o.hand, "right or left (the right hand's mirror image)")->capture_default_str();
-  cmd->add_option("--seed", s.seed, "Seed of every random choice")->capture_default_str();
+  cmd->add_option("--seed", s.seed, "Seed of every random choice")->check(WholeNumber())->capture_default_str();
   cmd->add_flag("--video", o.video, "Also write video.mp4");
   cmd->add_option("--out", o.out_dir, "Output folder")->capture_default_str();
   cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
@@ -150,7 +161,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
   cmd->add_flag("!--no-forearm-cut", e.cut_forearm, "Do not cut the forearm at the wrist");
   cmd->add_option("--fps", o.fps, "Frame rate of an image folder")->capture_default_str();
-  cmd->add_option("--max-frames", o.max_frames, "Stop after this many frames (0: all)")->capture_default_str();
+  cmd->add_option("--max-frames", o.max_frames, "Stop after this many frames (0: all)")->check(WholeNumber())->capture_default_str();
   cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   cmd->callback([&o]() {
     // A stop signal ends the run after the current frame, with complete files, and the
@@ -177,7 +188,7 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   pipeline->add_option("--width", p.width, "Frame width")->capture_default_str();
   pipeline->add_option("--height", p.height, "Frame height")->capture_default_str();
   pipeline->add_option("--k", p.k, "Neighbours per frame")->capture_default_str();
-  pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->capture_default_str();
+  pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->check(WholeNumber())->capture_default_str();
   pipeline->add_option("--threads", p.threads, "OpenCV threads for the image work (1: one core)")->capture_default_str();
   pipeline->add_option("--asset-dir", p.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   pipeline->add_flag("--json", json, "Print one JSON object");
@@ -188,7 +199,7 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   CLI::App* render = bench->add_subcommand("render", "Label images per second (hand + object, one core)");
   render->add_option("--images", o.images, "Images to time")->capture_default_str();
   render->add_option("--size", o.size, "Square image side, pixels")->capture_default_str();
-  render->add_option("--seed", o.seed, "Seed of the viewpoints and articulations")->capture_default_str();
+  render->add_option("--seed", o.seed, "Seed of the viewpoints and articulations")->check(WholeNumber())->capture_default_str();
   render->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   render->add_flag("--json", json, "Print one JSON object");
   render->callback([&o, &json]() {
@@ -276,7 +287,7 @@ void AddIndexOptions(CLI::App* cmd, nphand::IndexOptions& o, uint64_t& seed) {
   cmd->add_option("--flann-branching", o.flann.branching, "FLANN kmeans: branching")->capture_default_str();
   cmd->add_option("--flann-checks", o.flann.checks, "FLANN: leaves checked per query (-1: all)")->capture_default_str();
   cmd->add_option("--seed", seed, "Seed of the backend's random choices (LSH, HNSW, IVF: below 2^31; FLANN takes none)")
-      ->capture_default_str();
+      ->check(WholeNumber())->capture_default_str();
 }
 
 struct IndexArgs {
@@ -317,7 +328,7 @@ void AddEvalAnnCommand(CLI::App* eval, nphand::EvalAnnCommandOptions& o, bool& j
   std::vector<std::string> settings;
   for (const nphand::AnnConfig& c : nphand::StudyConfigs()) settings.push_back(c.name);
   ann->add_option("--backends", s.configs, "Backend settings (default all: " + CommaList(settings) + ")")->delimiter(',');
-  ann->add_option("--seed", s.seed, "Seed of the queries and the fractions' samples")->capture_default_str();
+  ann->add_option("--seed", s.seed, "Seed of the queries and the fractions' samples")->check(WholeNumber())->capture_default_str();
   ann->add_option("--out", o.out_dir, "Folder for the JSON and the plot");
   ann->add_option("--name", o.name, "File name of the JSON and the plot")->capture_default_str();
   ann->add_flag("--json", json, "Print one JSON object instead of the table");
@@ -341,7 +352,7 @@ void AddEvalEstimatorCommand(CLI::App* eval, nphand::EvalEstimatorCommandOptions
   cmd->add_option("--frames", s.frames, "Frames per sequence")->capture_default_str();
   cmd->add_option("--width", s.width, "Frame width")->capture_default_str();
   cmd->add_option("--height", s.height, "Frame height")->capture_default_str();
-  cmd->add_option("--seed", s.seed, "Sequence i uses seed + i")->capture_default_str();
+  cmd->add_option("--seed", s.seed, "Sequence i uses seed + i")->check(WholeNumber())->capture_default_str();
   cmd->add_option("--settings", s.settings, "Settings to run (default: the whole sweep)")->delimiter(',');
   cmd->add_option("--out", o.out_dir, "Folder for the JSON");
   cmd->add_option("--name", o.name, "File name of the JSON")->capture_default_str();
@@ -382,7 +393,7 @@ void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOption
     cmd->add_option("--width", s.width, "Frame width")->capture_default_str();
     cmd->add_option("--height", s.height, "Frame height")->capture_default_str();
     cmd->add_option("--seed", s.seed, "Test sequences use seed..seed+4, the robustness variants seed+100")
-        ->capture_default_str();
+        ->check(WholeNumber())->capture_default_str();
     cmd->add_option("--alphas", s.alphas, "Segmentation noise levels, % of hand pixels removed (noise)")
         ->delimiter(',')
         ->capture_default_str();
@@ -390,7 +401,7 @@ void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOption
     cmd->add_option("--lsq-rows", s.lsq_rows, "Database entries LSQ is fitted on")->capture_default_str();
     cmd->add_option("--gp-rows", s.gp_rows, "Database entries GP is fitted on")->capture_default_str();
     cmd->add_option("--rvm-rows", s.rvm_rows, "Database entries the RVM starts from")->capture_default_str();
-    cmd->add_option("--fit-seed", s.fit_seed, "Seed of the regressions' entries")->capture_default_str();
+    cmd->add_option("--fit-seed", s.fit_seed, "Seed of the regressions' entries")->check(WholeNumber())->capture_default_str();
     cmd->add_flag("--json", json, "Print one JSON object instead of the tables");
     return cmd;
   };
@@ -434,7 +445,7 @@ void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, nphand
   features->add_option("--db", o.db, "Database file")->capture_default_str();
   features->add_option("--queries", s.queries, "Query entries (left out in turn)")->capture_default_str();
   features->add_option("--neighbours", s.neighbours, "Neighbours per query (K)")->capture_default_str();
-  features->add_option("--seed", s.seed, "Seed of the query sample and rolls")->capture_default_str();
+  features->add_option("--seed", s.seed, "Seed of the query sample and rolls")->check(WholeNumber())->capture_default_str();
   features->add_option("--features", s.features,
                        "Features to compare (default all: joints, hog8x8x8, hog8x8x4, hog8x8x16, hog4x4x8, "
                        "hog16x16x8, hog8x8x8_pyr, hog8x8x8_nh, dist32)")->delimiter(',');

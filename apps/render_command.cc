@@ -139,6 +139,7 @@ RenderCommandResult RunRender(const RenderCommandOptions& options) {
   NPHAND_THROW_CHECK(options.Check(&why), "render: ", why);
   CheckFileName(options.name, "render --name");
   CheckOutputFolder(options.out_dir, "render --out");
+  CheckOutputsApart({{options.background, "--background"}}, {{options.out_dir, "render --out", {".png"}}});
   const HandModel model = HandModel::Load(HandednessFromString(options.hand), options.asset_dir);
   const Viewpoint view{options.azimuth_deg * kRadPerDeg, options.elevation_deg * kRadPerDeg, options.roll_deg * kRadPerDeg};
   if (options.grasp == "all") return RunGraspSheet(options, model, view);

@@ -169,7 +169,8 @@ TEST_F(EstimateCommandTest, BadInputsGiveTheirErrors) {
   testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "none, product or sum");
   // Truth and poses that do not belong together.
   {
-    std::ofstream(*dir_ / "broken.jsonl") << "{\"frame\": 0, \"detected\": true}\n";
+    std::ofstream broken(*dir_ / "broken.jsonl");
+    for (int frame = 0; frame < 5; ++frame) broken << "{\"frame\": " << frame << ", \"detected\": true}\n";
   }
   EvalPosesCommandOptions eval;
   eval.truth = *dir_ / "sequence" / "truth.jsonl";

@@ -97,6 +97,35 @@ TEST_F(PoseErrorsTest, JitterSkipsTheGapsOfUndetectedFrames) {
   EXPECT_NEAR(s.jitter_mm, 0.0, 1e-9);
   EXPECT_NEAR(s.truth_jitter_mm, 0.0, 1e-9);
 }
+TEST_F(PoseErrorsTest, APartRunOrAnotherSequenceIsRefused) {
+  const auto dir = testing::ScratchDir();
+  std::vector<nlohmann::json> truth, poses;
+  for (int f = 0; f < 8; ++f) truth.push_back(Line(f, true, hands_[f]));
+  for (int f = 0; f < 5; ++f) poses.push_back(Line(f, true, hands_[f]));
+  Write(dir / "truth.jsonl", truth);
+  testing::ExpectError([&] { ComparePoses(dir / "truth.jsonl", Write(dir / "part.jsonl", poses)); },
+                       "part.jsonl has 5 frames and " + (dir / "truth.jsonl").string() + " 8: a run is scored whole");
+  for (int f = 5; f < 10; ++f) poses.push_back(Line(f, true, hands_[f % 8]));
+  testing::ExpectError([&] { ComparePoses(dir / "truth.jsonl", Write(dir / "long.jsonl", poses)); }, "has 10 frames");
+}
+
+TEST_F(PoseErrorsTest, NothingDetectedReadsAsNothingMeasuredNotAsPerfect) {
+  const auto dir = testing::ScratchDir();
+  std::vector<nlohmann::json> truth, poses;
+  for (int f = 0; f < 4; ++f) {
+    truth.push_back(Line(f, true, hands_[f]));
+    poses.push_back(Line(f, false, hands_[f]));
+  }
+  const PoseErrorSummary s = ComparePoses(Write(dir / "truth.jsonl", truth), Write(dir / "poses.jsonl", poses));
+  EXPECT_EQ(s.detected, 0);
+  const nlohmann::json json = ToJson(s);
+  for (const char* key : {"within_20mm", "auc_0_50", "jitter_mm", "truth_jitter_mm"}) EXPECT_TRUE(json[key].is_null()) << key;
+  for (const auto& [name, value] : json["mean"].items()) EXPECT_TRUE(value.is_null()) << name;
+  const std::string table = FormatTable(s);
+  EXPECT_NE(table.find("detected 0 of 4 frames"), std::string::npos);
+  EXPECT_EQ(table.find("0.00"), std::string::npos) << table;
+  EXPECT_NE(table.find("n/a"), std::string::npos);
+}
 
 }  // namespace
 }  // namespace nphand

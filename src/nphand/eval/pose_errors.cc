@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <numbers>
 #include <span>
 #include <sstream>
@@ -73,8 +74,9 @@ double Mean(const std::vector<double>& v) {
 
 PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std::filesystem::path& poses_path) {
   const std::vector<nlohmann::json> truth = ReadLines(truth_path), poses = ReadLines(poses_path);
-  NPHAND_THROW_CHECK(poses.size() <= truth.size(), poses_path.string(), " has ", poses.size(), " frames, ",
-                     truth_path.string(), " only ", truth.size());
+  NPHAND_THROW_CHECK(poses.size() == truth.size(), poses_path.string(), " has ", poses.size(), " frames and ",
+                     truth_path.string(), " ", truth.size(),
+                     ": a run is scored whole (was it stopped, cut by --max-frames, or made on another sequence?)");
   PoseErrorSummary summary;
   std::array<std::vector<double>, kMeasures.size()> values;
   std::vector<double> distances;  // every keypoint's, about the wrist
@@ -142,12 +144,15 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
     }
     summary.frames.push_back(e);
   }
+  // Nothing detected, nothing measured: not a number, never a perfect 0.
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   for (const std::vector<double>& v : values) {
-    summary.mean.push_back(Mean(v));
-    summary.median.push_back(Median(v));
+    summary.mean.push_back(v.empty() ? kNaN : Mean(v));
+    summary.median.push_back(v.empty() ? kNaN : Median(v));
   }
-  summary.within_20mm = FractionWithin(distances, 0.02);
-  summary.auc_0_50 = AreaUnderCurve(distances, 0.05);
+  summary.within_20mm = distances.empty() ? kNaN : FractionWithin(distances, 0.02);
+  summary.auc_0_50 = distances.empty() ? kNaN : AreaUnderCurve(distances, 0.05);
+  summary.jitter_mm = summary.truth_jitter_mm = kNaN;
   // Jitter over each run of consecutive detected frames, weighted by its second differences.
   double jitter = 0.0, truth_jitter = 0.0, weight = 0.0;
   for (size_t begin = 0, end = 0; begin < detected_frames.size(); begin = end) {
@@ -168,11 +173,21 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
   return summary;
 }
 
+namespace {
+
+// A figure, or null when there was nothing to measure.
+nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+// A figure with two decimals, or "n/a".
+std::string Figure(double v) { return std::isfinite(v) ? cv::format("%.2f", v) : std::string("n/a"); }
+
+}  // namespace
+
 nlohmann::json ToJson(const PoseErrorSummary& summary) {
   nlohmann::json mean = nlohmann::json::object(), median = nlohmann::json::object();
   for (size_t m = 0; m < kMeasures.size(); ++m) {
-    mean[kMeasures[m]] = summary.mean[m];
-    median[kMeasures[m]] = summary.median[m];
+    mean[kMeasures[m]] = Number(summary.mean[m]);
+    median[kMeasures[m]] = Number(summary.median[m]);
   }
   nlohmann::json frames = nlohmann::json::array();
   for (const FramePoseError& e : summary.frames) {
@@ -191,10 +206,10 @@ nlohmann::json ToJson(const PoseErrorSummary& summary) {
           {"detected", summary.detected},
           {"mean", mean},
           {"median", median},
-          {"within_20mm", summary.within_20mm},
-          {"auc_0_50", summary.auc_0_50},
-          {"jitter_mm", summary.jitter_mm},
-          {"truth_jitter_mm", summary.truth_jitter_mm},
+          {"within_20mm", Number(summary.within_20mm)},
+          {"auc_0_50", Number(summary.auc_0_50)},
+          {"jitter_mm", Number(summary.jitter_mm)},
+          {"truth_jitter_mm", Number(summary.truth_jitter_mm)},
           {"per_frame", frames}};
 }
 
@@ -202,13 +217,13 @@ std::string FormatTable(const PoseErrorSummary& summary) {
   std::ostringstream out;
   out << "detected " << summary.detected << " of " << summary.frames.size() << " frames\n";
   out << std::left << std::setw(14) << "measure" << std::right << std::setw(10) << "mean" << std::setw(10) << "median" << "\n";
-  out << std::fixed << std::setprecision(2);
   for (size_t m = 0; m < kMeasures.size(); ++m) {
-    out << std::left << std::setw(14) << kMeasures[m] << std::right << std::setw(10) << summary.mean[m] << std::setw(10)
-        << summary.median[m] << "\n";
+    out << std::left << std::setw(14) << kMeasures[m] << std::right << std::setw(10) << Figure(summary.mean[m])
+        << std::setw(10) << Figure(summary.median[m]) << "\n";
   }
-  out << "keypoints within 20 mm " << summary.within_20mm << ", AUC 0-50 mm " << summary.auc_0_50 << "\n";
-  out << "jitter " << summary.jitter_mm << " mm/frame^2 (the truth's own " << summary.truth_jitter_mm << ")\n";
+  out << "keypoints within 20 mm " << Figure(summary.within_20mm) << ", AUC 0-50 mm " << Figure(summary.auc_0_50) << "\n";
+  out << "jitter " << Figure(summary.jitter_mm) << " mm/frame^2 (the truth's own " << Figure(summary.truth_jitter_mm)
+      << "; over runs of three detected frames)\n";
   return out.str();
 }
 

@@ -29,7 +29,8 @@ struct PoseErrorSummary {
   std::vector<FramePoseError> frames;
   int detected = 0;
   // Over detected frames: mean and median of each measure, in the order joint_deg,
-  // wrist_deg, keypoint_mm, keypoint_px, camera_mm, pa_mpjpe_mm.
+  // wrist_deg, keypoint_mm, keypoint_px, camera_mm, pa_mpjpe_mm. Every figure of the
+  // summary is NaN (null in JSON, "n/a" in the table) when there was nothing to measure.
   std::vector<double> mean, median;
   // Over every keypoint of the detected frames (about the wrist, as keypoint_mm): the
   // fraction within 20 mm and the area under that fraction's curve over 0-50 mm.
@@ -41,8 +42,8 @@ struct PoseErrorSummary {
   double truth_jitter_mm = 0.0;
 };
 
-// Reads both files (one JSON object per line, the same frames in the same order) and
-// compares them. Throws nphand::Error naming the file and line of anything missing or
+// Reads both files (one JSON object per line, the same frames in the same order, as many in
+// one as in the other) and compares them. Throws nphand::Error naming the file and line of anything missing or
 // mismatched.
 PoseErrorSummary ComparePoses(const std::filesystem::path& truth, const std::filesystem::path& poses);
 
