@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "apps/frame_source.h"
+#include "apps/video_file.h"
 #include "nphand/estimate/frame_json.h"
 #include "nphand/index/backends.h"
 #include "nphand/render/draw.h"
@@ -60,18 +61,6 @@ cv::Mat Overlay(const cv::Mat& frame, const FrameResult& result, Estimator* esti
 
 namespace {
 
-// `picture` scaled to fit `size` with its aspect kept, on a dark border: an overlay video
-// has one frame size, and a folder's images may differ.
-cv::Mat FitInto(const cv::Mat& picture, cv::Size size) {
-  if (picture.size() == size) return picture;
-  const double scale = std::min(static_cast<double>(size.width) / picture.cols, static_cast<double>(size.height) / picture.rows);
-  const cv::Size fitted(std::max(1, static_cast<int>(picture.cols * scale)), std::max(1, static_cast<int>(picture.rows * scale)));
-  cv::Mat out(size, CV_8UC3, cv::Scalar(32, 32, 32));
-  cv::resize(picture, out(cv::Rect((size.width - fitted.width) / 2, (size.height - fitted.height) / 2, fitted.width, fitted.height)),
-             fitted, 0, 0, cv::INTER_AREA);
-  return out;
-}
-
 // The overlay's frame for an image that could not be read: grey, with why.
 cv::Mat UnreadablePicture(cv::Size size, const std::string& reason) {
   cv::Mat picture(size, CV_8UC3, cv::Scalar(64, 64, 64));
@@ -79,62 +68,6 @@ cv::Mat UnreadablePicture(cv::Size size, const std::string& reason) {
               std::max(0.4, size.height / 960.0) * 0.5, cv::Scalar(80, 80, 255), 1, cv::LINE_AA);
   return picture;
 }
-
-// The overlay video, written under "<path>.partial.mp4" (locked against a second run), its
-// frame size that of the first picture; every later picture is fitted into it, so that the
-// video keeps one frame per line. Finish() checks what reached the disk before renaming.
-class OverlayWriter {
- public:
-  OverlayWriter(const std::filesystem::path& path, double fps)
-      : path_(path), partial_(path.string() + ".partial.mp4"), lock_(File::OpenLocked(partial_)), fps_(fps) {
-    lock_.Truncate(0);
-  }
-  ~OverlayWriter() {
-    if (done_) return;
-    video_.release();
-    std::error_code ec;
-    std::filesystem::remove(partial_, ec);
-  }
-  // Sets the frame size if this is the first picture.
-  void Size(cv::Size size) {
-    if (size_.area() == 0) size_ = size;
-  }
-  cv::Size size() const { return size_; }
-  void Write(const cv::Mat& picture) {
-    Size(picture.size());
-    if (!video_.isOpened()) {
-      video_.open(partial_.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps_, size_);
-      NPHAND_THROW_CHECK(video_.isOpened(), partial_.string(), ": cannot open a video writer (MPEG-4)");
-    }
-    video_.write(FitInto(picture, size_));
-    ++frames_;
-  }
-  uint64_t frames() const { return frames_; }
-  // OpenCV's writer reports no failed write (a full disk), so the finished file is read back:
-  // it must open and hold every frame written.
-  void Finish() {
-    video_.release();
-    cv::VideoCapture check(partial_.string(), cv::CAP_FFMPEG);
-    const double held = check.isOpened() ? check.get(cv::CAP_PROP_FRAME_COUNT) : 0.0;
-    check.release();
-    NPHAND_THROW_CHECK(held == static_cast<double>(frames_), path_.string(), ": the overlay video is damaged: ",
-                       partial_.string(), " holds ", static_cast<uint64_t>(held), " of the ", frames_,
-                       " frames written (is the disk full?); it was removed");
-    std::error_code ec;
-    std::filesystem::rename(partial_, path_, ec);
-    NPHAND_THROW_CHECK(!ec, path_.string(), ": cannot rename ", partial_.string(), " into place (", ec.message(), ")");
-    done_ = true;
-  }
-
- private:
-  std::filesystem::path path_, partial_;
-  File lock_;
-  double fps_;
-  cv::VideoWriter video_;
-  cv::Size size_;
-  uint64_t frames_ = 0;
-  bool done_ = false;
-};
 
 // Every file a run reads: refused as an output.
 std::vector<NamedPath> Inputs(const EstimateCommandOptions& options, const std::filesystem::path& index_path,
@@ -190,7 +123,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   // The outputs are taken (locked) before the long load, so that a second run into them is
   // refused at once; their final names are replaced only when the run has frames to show.
   LineFile lines(options.out);
-  std::optional<OverlayWriter> overlay;
+  std::optional<VideoFile> overlay;
   if (!options.overlay.empty()) overlay.emplace(options.overlay, source.fps());
 
   const Database db = Database::Open(options.db);

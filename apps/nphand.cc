@@ -23,6 +23,12 @@
 
 namespace {
 
+// JSON as printed: a path that is not UTF-8 (file names are bytes) prints with U+FFFD in
+// place of its bad bytes instead of failing after the work is done.
+std::string Dump(const nlohmann::json& json, int indent = -1) {
+  return json.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 // "a, b, c": for the lists of names in help texts.
 std::string CommaList(const std::vector<std::string>& names) {
   std::string list;
@@ -168,7 +174,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
     // status says it was stopped: 128 + the signal's number (130 for Ctrl-C).
     CatchStopSignals();
     const nlohmann::json summary = nphand::RunEstimate(o, &std::cerr, &g_stop);
-    std::cout << summary.dump(2) << "\n";
+    std::cout << Dump(summary, 2) << "\n";
     if (summary["stopped"].get<bool>()) {
       std::cerr << "estimate: stopped by " << nphand::SignalName(g_stop) << " after " << summary["frames"] << " frames"
                 << (summary["out"].is_null() ? "; nothing was written" : "") << "\n";
@@ -194,7 +200,7 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   pipeline->add_flag("--json", json, "Print one JSON object");
   pipeline->callback([&p, &json]() {
     const nlohmann::json report = nphand::RunBenchPipeline(p);
-    std::cout << (json ? report.dump() : report.dump(2)) << "\n";
+    std::cout << (json ? Dump(report) : Dump(report, 2)) << "\n";
   });
   CLI::App* render = bench->add_subcommand("render", "Label images per second (hand + object, one core)");
   render->add_option("--images", o.images, "Images to time")->capture_default_str();
@@ -205,14 +211,14 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   render->callback([&o, &json]() {
     const nlohmann::json report = nphand::RunBenchRender(o);
     if (json) {
-      std::cout << report.dump() << "\n";
+      std::cout << Dump(report) << "\n";
     } else {
-      std::cout << report.dump(2) << "\n";
+      std::cout << Dump(report, 2) << "\n";
     }
   });
 }
 
-void PrintJson(const nlohmann::json& report, bool json) { std::cout << (json ? report.dump() : report.dump(2)) << "\n"; }
+void PrintJson(const nlohmann::json& report, bool json) { std::cout << (json ? Dump(report) : Dump(report, 2)) << "\n"; }
 
 struct DbArgs {
   nphand::DbBuildCommandOptions build;
@@ -335,7 +341,7 @@ void AddEvalAnnCommand(CLI::App* eval, nphand::EvalAnnCommandOptions& o, bool& j
   ann->callback([&o, &json]() {
     const nphand::AnnStudyResult result = nphand::RunEvalAnn(o);
     if (json) {
-      std::cout << nphand::ToJson(result).dump() << "\n";
+      std::cout << Dump(nphand::ToJson(result)) << "\n";
     } else {
       std::cout << nphand::FormatTable(result);
     }
@@ -361,7 +367,7 @@ void AddEvalEstimatorCommand(CLI::App* eval, nphand::EvalEstimatorCommandOptions
   cmd->callback([&o, &json]() {
     const std::vector<nphand::EstimatorScore> scores = nphand::RunEvalEstimator(o);
     if (json) {
-      std::cout << nphand::ToJson(scores).dump() << "\n";
+      std::cout << Dump(nphand::ToJson(scores)) << "\n";
     } else {
       std::cout << nphand::FormatTable(scores);
     }
@@ -377,7 +383,7 @@ void AddEvalPosesCommand(CLI::App* eval, nphand::EvalPosesCommandOptions& o, boo
   cmd->add_flag("--json", json, "Print JSON (with every frame) instead of the table");
   cmd->callback([&o, &json]() {
     const nphand::PoseErrorSummary summary = nphand::RunEvalPoses(o);
-    std::cout << (json ? nphand::ToJson(summary).dump() + "\n" : nphand::FormatTable(summary));
+    std::cout << (json ? Dump(nphand::ToJson(summary)) + "\n" : nphand::FormatTable(summary));
   });
 }
 
@@ -407,7 +413,7 @@ void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOption
   };
   const auto print = [&json](const nphand::PoseStudyResult& r) {
     if (json) {
-      std::cout << nphand::ToJson(r).dump() << "\n";
+      std::cout << Dump(nphand::ToJson(r)) << "\n";
       return;
     }
     for (const nlohmann::json& sequence : r.sequences) {
@@ -427,7 +433,7 @@ void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOption
       ->callback([&o, print]() { print(nphand::RunEvalPoseStudy(Part::kRobustness, o)); });
   add("all", "The whole study: features, ann, baselines, noise, robustness (needs --out)")->callback([&o, &json]() {
     const nlohmann::json summary = nphand::RunEvalAll(o);
-    std::cout << (json ? summary.dump() : summary.dump(2)) << "\n";
+    std::cout << (json ? Dump(summary) : Dump(summary, 2)) << "\n";
   });
 }
 
@@ -458,7 +464,7 @@ void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, nphand
     o.quiet = json;
     const nphand::FeatureStudyResult result = nphand::RunEvalFeatures(o);
     if (json) {
-      std::cout << nphand::ToJson(result).dump() << "\n";
+      std::cout << Dump(nphand::ToJson(result)) << "\n";
     } else {
       std::cout << nphand::FormatTable(result);
     }

@@ -1,9 +1,9 @@
 #include "apps/sequence_command.h"
 
 #include <cstdio>
+#include <optional>
 
-#include <opencv2/videoio.hpp>
-
+#include "apps/video_file.h"
 #include "nphand/render/draw.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
@@ -28,12 +28,9 @@ nlohmann::json RunSequence(const SequenceCommandOptions& options, std::ostream* 
   nlohmann::json description = sequence.Describe();
   description["files"] = {{"frames", "frames/%06d.png"}, {"labels", "labels/%06d.png"}, {"truth", "truth.jsonl"}};
 
-  cv::VideoWriter video;
-  const std::filesystem::path video_partial = options.out_dir / "video.mp4.partial.mp4";
+  std::optional<VideoFile> video;
   if (options.video) {
-    video.open(video_partial.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), sequence_options.fps,
-               cv::Size(sequence_options.width, sequence_options.height));
-    NPHAND_THROW_CHECK(video.isOpened(), video_partial.string(), ": cannot open a video writer (MPEG-4)");
+    video.emplace(options.out_dir / "video.mp4", sequence_options.fps);
     description["files"]["video"] = "video.mp4";
   }
   std::string truth;
@@ -45,14 +42,11 @@ nlohmann::json RunSequence(const SequenceCommandOptions& options, std::ostream* 
     WriteImageAtomic(options.out_dir / "frames" / name, frame.rgb);
     WriteImageAtomic(options.out_dir / "labels" / name, frame.labels);
     truth += FrameTruthJson(frame).dump() + "\n";
-    if (video.isOpened()) video.write(frame.rgb);
+    if (video.has_value()) video->Write(frame.rgb);
     line.Update(static_cast<uint64_t>(i + 1));
   }
   line.Finish();
-  if (video.isOpened()) {
-    video.release();
-    std::filesystem::rename(video_partial, options.out_dir / "video.mp4");
-  }
+  if (video.has_value()) video->Finish();
   WriteFileAtomic(options.out_dir / "truth.jsonl", truth);
   WriteFileAtomic(options.out_dir / "sequence.json", description.dump(2) + "\n");
   return description;

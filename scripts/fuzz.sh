@@ -7,7 +7,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds=60
-targets=(db_file db_content db_resume glb index index_body poses)
+targets=(db_file db_content db_resume glb index index_body poses frames)
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
@@ -30,7 +30,7 @@ fi
 build="$root/build-fuzz"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DNPHAND_FUZZ=ON -DNPHAND_BUILD_TESTS=OFF -DNPHAND_BUILD_BENCH=OFF >/dev/null
-cmake --build "$build" --parallel "$(nproc)" --target nphand "${targets[@]/#/fuzz_}"
+cmake --build "$build" --parallel "$(nproc)" --target nphand frame_seeds "${targets[@]/#/fuzz_}"
 
 # Seeds: a real small database (and a shard of it), split the ways the targets take them.
 cache="$root/.cache/fuzz"
@@ -82,11 +82,14 @@ done
 export NPHAND_FUZZ_DB="$seeds/tiny.db"  # the database the index target loads its inputs against
 # poses: a short rendered sequence's truth, and the poses estimated on it as the seed.
 mkdir -p "$seeds/poses"
-"$build/apps/nphand" sequence --frames 3 --width 96 --height 72 --distance 0.3 --grasp 1 --out "$seeds/sequence" >/dev/null 2>&1
+"$build/apps/nphand" sequence --frames 3 --width 96 --height 72 --distance 0.3 --grasp 1 --video --out "$seeds/sequence" >/dev/null 2>&1
 "$build/apps/nphand" estimate --db "$seeds/tiny.db" --index "$seeds/index/tiny.idx" --input "$seeds/sequence/frames" \
   --k 20 --max-distance 2 --top --no-faces --out "$seeds/poses/estimated.jsonl" >/dev/null 2>&1
 cp "$seeds/sequence/truth.jsonl" "$seeds/poses/truth.jsonl"
 export NPHAND_FUZZ_TRUTH="$seeds/sequence/truth.jsonl"
+# frames: the sequence's first frame as PNG, JPEG (whole and cut short) and BMP, its video
+# and a Motion JPEG AVI, each behind the target's selector byte.
+"$build/tests/fuzz/frame_seeds" "$seeds/sequence/frames" "$seeds/sequence/video.mp4" "$seeds/frames"
 
 failed=0
 for t in "${targets[@]}"; do

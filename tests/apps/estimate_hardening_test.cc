@@ -311,7 +311,7 @@ TEST_F(EstimateHardeningTest, AnOverlayThatCannotBeWrittenWholeFailsTheRunAndIsN
   args.insert(args.end(), {"--overlay", (dir / "overlay.mp4").string()});
   Child child(args, dir, 80000);
   EXPECT_EQ(child.Wait(), 1) << child.Err();
-  EXPECT_NE(child.Err().find("the overlay video is damaged"), std::string::npos) << child.Err();
+  EXPECT_NE(child.Err().find("overlay.mp4: the video is damaged"), std::string::npos) << child.Err();
   EXPECT_NE(child.Err().find("the poses are complete in"), std::string::npos) << child.Err();
   EXPECT_EQ(Lines(dir / "poses.jsonl").size(), 8u);
   EXPECT_FALSE(std::filesystem::exists(dir / "overlay.mp4"));
