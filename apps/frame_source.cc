@@ -84,7 +84,8 @@ FrameSource::FrameSource(const std::string& input, double fps) : input_(input), 
   // FFmpeg reads every common container; GStreamer, the other back end Debian's OpenCV
   // tries, fails on a file that is not a video with an assertion of its own.
   capture_.open(input, cv::CAP_FFMPEG);
-  NPHAND_THROW_CHECK(capture_.isOpened(), input, ": cannot read this as a video");
+  NPHAND_THROW_CHECK(capture_.isOpened(), input,
+                     ": cannot read this as a video (not a video, or damaged: an MP4 cut short before its index cannot be read at all)");
   const double video_fps = capture_.get(cv::CAP_PROP_FPS);
   if (video_fps > 0.0) fps_ = video_fps;
   const double frames = capture_.get(cv::CAP_PROP_FRAME_COUNT);

@@ -72,23 +72,29 @@ class Child {
  public:
   Child(const std::vector<std::string>& args, const std::filesystem::path& dir, rlim_t file_limit = RLIM_INFINITY)
       : out_(dir / "child.out"), err_(dir / "child.err") {
-    pid_ = ::fork();
-    if (pid_ != 0) return;
-    const int out = ::open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int err = ::open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(out, 1);
-    ::dup2(err, 2);
-    if (file_limit != RLIM_INFINITY) {
-      std::signal(SIGXFSZ, SIG_IGN);
-      rlimit limit;
-      limit.rlim_cur = limit.rlim_max = file_limit;
-      ::setrlimit(RLIMIT_FSIZE, &limit);
-    }
+    // Everything is made before the fork: between fork and exec the child of a threaded
+    // process may only make async-signal-safe calls (no allocation).
     std::vector<char*> argv = {const_cast<char*>(NPHAND_BINARY)};
     for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
     argv.push_back(nullptr);
+    const int out = ::open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    const int err = ::open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    rlimit limit;
+    limit.rlim_cur = limit.rlim_max = file_limit;
+    pid_ = ::fork();
+    if (pid_ != 0) {
+      ::close(out);
+      ::close(err);
+      return;
+    }
+    ::dup2(out, 1);
+    ::dup2(err, 2);
+    if (file_limit != RLIM_INFINITY) {
+      ::signal(SIGXFSZ, SIG_IGN);
+      ::setrlimit(RLIMIT_FSIZE, &limit);
+    }
     ::execv(NPHAND_BINARY, argv.data());
-    std::_Exit(127);
+    ::_exit(127);
   }
   ~Child() {
     if (!waited_) {

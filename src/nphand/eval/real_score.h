@@ -1,0 +1,130 @@
+// Scores hand-pose predictions on labelled real images and video frames (`nphand eval
+// real`): the measures of real-dev's reference scorer (score_realdev.py), computed the same
+// way, so that its figures and nphand's agree on the same predictions.
+//
+// Per labelled hand (one line of labels.jsonl):
+//  - label box: the bounding box of its labelled 2D keypoints (or its `bbox_px` when it has
+//    none); diag its diagonal; found region: the box grown by 25 % of its width on the left
+//    and right and 25 % of its height at the top and bottom;
+//  - matching: per image, predicted hands are paired one-to-one with labelled hands; a pair
+//    is eligible when the predicted keypoints' centroid lies in the found region; the
+//    assignment with the most pairs wins, ties going to the smallest summed cost (the mean
+//    normalised 2D error, or for a box only the centroid's distance from the box centre over
+//    diag). A labelled hand with a partner is found; a predicted hand without one is extra;
+//  - normalised error e_k = |pred_k - label_k| / diag per labelled keypoint; PCK@t the
+//    fraction with e_k < t (t = 0.1, 0.2);
+//  - handedness: the predicted side against the labelled one, where a side is predicted;
+//  - PA-MPJPE (mm): with 3D labels (the camera's, or for the video MediaPipe's world
+//    landmarks), after a similarity alignment without reflection;
+//  - finger states: index to little, extended iff |MCP->tip| over the finger's bone lengths
+//    exceeds 0.75, on the label's and the prediction's 3D; agreement out of 4 per hand.
+// Aggregates are over hands (each hand counts once), per source, over the ground-truth
+// sources (FreiHAND, OneHand10K, Panoptic, InterHand, HaGRID) and over their one-hand and
+// two-hand images apart.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "nphand/model/hand_model.h"
+
+namespace nphand {
+
+struct RealLabel {
+  int line = 0;                   // 0-based line of labels.jsonl
+  std::string file;               // relative to the labels' folder
+  std::optional<int> frame;       // a video's frame
+  std::string source;             // freihand, onehand10k, panoptic, interhand, hagrid, tfjs_hands, mediapipe_thumbs_up, asl_video, other
+  std::string hand;               // "left" or "right" as it appears in the image; empty: not given
+  std::string hand_side_by;       // "source" or "eye"
+  std::array<std::optional<Eigen::Vector2d>, kNumKeypoints> keypoints_2d;  // pixels; unlabelled joints empty
+  std::vector<int> labelled;      // the joints with a 2D position
+  std::optional<Keypoints3d> keypoints_3d;  // metres: the camera's, or MediaPipe's world landmarks (video)
+  bool world_3d = false;          // keypoints_3d are MediaPipe's world landmarks
+  std::array<double, 4> box{};    // x_min, y_min, x_max, y_max
+  double diag = 0.0;
+  std::array<double, 4> region{};  // the found region
+  // Which image (file, frame) the line belongs to.
+  std::pair<std::string, int> key() const { return {file, frame.value_or(-1)}; }
+};
+
+// The source a label file name belongs to (the reference's source_of).
+std::string RealSourceOf(const std::string& file);
+// Whether a source's labels are ground truth (not MediaPipe's own outputs).
+bool IsGroundTruthSource(const std::string& source);
+
+// Reads labels.jsonl. Throws nphand::Error naming the line of anything malformed: not JSON,
+// no `file`, keypoints not 21 [x, y] (or null), 3D not 21 [x, y, z], a side not left or
+// right, neither keypoints nor a box.
+std::vector<RealLabel> ReadRealLabels(const std::filesystem::path& path);
+
+struct PredictedHand {
+  std::array<Eigen::Vector2d, kNumKeypoints> keypoints_2d{};  // pixels, origin at the image's top-left corner
+  std::optional<Keypoints3d> keypoints_3d;                     // metres, any hand-centred frame
+  std::string hand;                                            // "left", "right" or empty
+};
+
+// What a system reported for one labelled image or video frame.
+struct RealPrediction {
+  std::string file;
+  std::optional<int> frame;
+  std::vector<PredictedHand> hands;  // empty: no hand found
+  std::optional<double> ms;
+  std::pair<std::string, int> key() const { return {file, frame.value_or(-1)}; }
+};
+
+// One line of the reference's generic predictions JSONL.
+nlohmann::json ToJson(const RealPrediction& prediction);
+// Reads a generic predictions JSONL (the reference scorer's format), matching each line's
+// `file` to a label's as the reference does (the same path, or for a still the same stem).
+// Throws nphand::Error naming the line of anything malformed or unmatched, or repeated.
+std::vector<RealPrediction> ReadRealPredictions(const std::filesystem::path& path, const std::vector<RealLabel>& labels);
+
+struct RealHandScore {
+  const RealLabel* label = nullptr;
+  int hands_in_image = 0;             // labelled hands in the same image
+  bool run = false;                   // the image has a prediction record
+  bool found = false;
+  std::optional<double> pck_01, pck_02, mean_norm_err, mean_err_px;  // found hands with keypoints
+  std::optional<bool> handedness_ok;  // found hands whose prediction has a side
+  std::optional<double> pa_mpjpe_mm;  // found hands with 3D on both sides
+  std::optional<int> finger_agree;    // of 4
+  std::optional<Eigen::Vector2d> centroid;  // the partner's keypoint centroid
+};
+
+struct RealAggregate {
+  int hands = 0, images = 0, found = 0, not_run = 0, extra = 0, kp_hands = 0, kp_found = 0;
+  std::optional<double> pck_01_found, pck_02_found, pck_01_all, pck_02_all;
+  std::optional<double> mean_norm_err_found, median_norm_err_found, mean_err_px_found;
+  int handedness_n = 0, handedness_correct = 0, handedness_source_n = 0, handedness_source_correct = 0;
+  int pa_mpjpe_n = 0, hands_with_3d_label = 0;
+  std::optional<double> pa_mpjpe_mm;
+  int finger_agree = 0, finger_total = 0;
+  std::optional<double> found_rate() const { return hands > 0 ? std::optional<double>(double(found) / hands) : std::nullopt; }
+};
+
+struct RealScore {
+  std::vector<RealHandScore> hands;                  // in label order within each image
+  std::vector<std::pair<std::string, int>> extras;   // (file, frame) of each extra predicted hand
+  std::map<std::string, RealAggregate> per_source;
+  RealAggregate gt_all, gt_one_hand, gt_two_hand;
+  std::optional<double> stills_median_ms, video_median_ms;
+};
+
+// Scores `predictions` against `labels`. Throws nphand::Error for a prediction of an image
+// with no label. An image without a prediction record is "not run": its hands are not found.
+RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<RealPrediction>& predictions);
+
+// The reference's figures, under its names: {"per_source": {...}, "overall": {"gt_all",
+// "gt_one_hand_images", "gt_two_hand_images"}, "timing", "per_hand"}.
+nlohmann::json ToJson(const RealScore& score);
+std::string FormatTable(const RealScore& score);
+
+}  // namespace nphand

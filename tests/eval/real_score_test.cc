@@ -1,0 +1,236 @@
+// The real-image scorer: its measures on labels and predictions written here, its refusals
+// of malformed files, and (when ../shared/real-dev and python3 are there) the same figures
+// as real-dev's reference scorer, score_realdev.py, on the same predictions.
+#include "nphand/eval/real_score.h"
+
+#include <cstdlib>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "nphand/util/random.h"
+#include "testing/testing.h"
+
+namespace nphand {
+namespace {
+
+std::filesystem::path Write(const std::filesystem::path& path, const std::vector<nlohmann::json>& lines) {
+  std::ofstream out(path);
+  for (const nlohmann::json& line : lines) out << line.dump() << "\n";
+  return path;
+}
+
+// A hand of 21 keypoints spread over a 100 x 100 box at (x, y).
+nlohmann::json Keypoints(double x, double y) {
+  nlohmann::json points = nlohmann::json::array();
+  for (int k = 0; k < kNumKeypoints; ++k) points.push_back({x + 5.0 * k, y + 100.0 * (k % 2)});
+  return points;
+}
+
+nlohmann::json Shifted(const nlohmann::json& points, double dx, double dy) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const nlohmann::json& p : points) out.push_back({p[0].get<double>() + dx, p[1].get<double>() + dy});
+  return out;
+}
+
+TEST(RealScoreTest, FoundPckAndHandednessFollowTheDefinitions) {
+  const auto dir = testing::ScratchDir();
+  const nlohmann::json a = Keypoints(100, 100), b = Keypoints(400, 100);
+  const double diag = std::hypot(100.0, 100.0);
+  Write(dir / "labels.jsonl",
+        {{{"file", "images/freihand_1.jpg"}, {"hand", "right"}, {"hand_side_by", "source"}, {"keypoints_2d_px", a}},
+         {{"file", "images/onehand10k_2.jpg"}, {"hand", "left"}, {"keypoints_2d_px", a}},
+         {{"file", "images/panoptic_3.jpg"}, {"hand", "left"}, {"keypoints_2d_px", a}},
+         {{"file", "images/panoptic_3.jpg"}, {"hand", "right"}, {"keypoints_2d_px", b}},
+         {{"file", "images/hagrid_call.png"}, {"hand", "right"}, {"bbox_px", {0, 0, 100, 100}}}});
+  const std::vector<RealLabel> labels = ReadRealLabels(dir / "labels.jsonl");
+  ASSERT_EQ(labels.size(), 5u);
+  EXPECT_EQ(labels[0].source, "freihand");
+  EXPECT_NEAR(labels[0].diag, diag, 1e-9);
+  // freihand: every joint 0.15 diag off (PCK@0.1 0, PCK@0.2 1); onehand10k: off the
+  // grown box (not found); panoptic: one hand, the right one, exact and on the wrong side;
+  // hagrid: a hand near the box with an extra hand far away.
+  const double off = 0.15 * diag / std::sqrt(2.0);
+  Write(dir / "predictions.jsonl",
+        {{{"file", "freihand_1.png"}, {"hands", {{{"keypoints_2d_px", Shifted(a, off, off)}, {"hand", "right"}}}}, {"ms", 4.0}},
+         {{"file", "images/onehand10k_2.jpg"}, {"hands", {{{"keypoints_2d_px", Shifted(a, 500, 0)}}}}, {"ms", 6.0}},
+         {{"file", "images/panoptic_3.jpg"}, {"hands", {{{"keypoints_2d_px", b}, {"hand", "left"}}}}},
+         {{"file", "images/hagrid_call.png"},
+          {"hands", {{{"keypoints_2d_px", Shifted(a, -70, -70)}}, {{"keypoints_2d_px", Shifted(a, 900, 900)}}}}}});
+  const RealScore score = ScoreReal(labels, ReadRealPredictions(dir / "predictions.jsonl", labels));
+  ASSERT_EQ(score.hands.size(), 5u);
+  EXPECT_TRUE(score.hands[0].found);
+  EXPECT_DOUBLE_EQ(*score.hands[0].pck_01, 0.0);
+  EXPECT_DOUBLE_EQ(*score.hands[0].pck_02, 1.0);
+  EXPECT_NEAR(*score.hands[0].mean_norm_err, 0.15, 1e-9);
+  EXPECT_TRUE(*score.hands[0].handedness_ok);
+  EXPECT_FALSE(score.hands[1].found);
+  EXPECT_FALSE(score.hands[2].found) << "the one predicted hand goes to the labelled hand it lies on";
+  EXPECT_TRUE(score.hands[3].found);
+  EXPECT_FALSE(*score.hands[3].handedness_ok);
+  EXPECT_TRUE(score.hands[4].found);
+  EXPECT_EQ(score.extras.size(), 2u) << "onehand10k's hand off its box and hagrid's far one";
+  EXPECT_EQ(score.gt_all.hands, 5);
+  EXPECT_EQ(score.gt_all.found, 3);
+  EXPECT_EQ(score.gt_all.kp_hands, 4);
+  EXPECT_NEAR(*score.gt_all.pck_02_found, 1.0, 1e-12) << "0.15 and 0 off";
+  EXPECT_NEAR(*score.gt_all.pck_02_all, 0.5, 1e-12) << "two of four hands with keypoints found";
+  EXPECT_EQ(score.gt_one_hand.hands, 3);
+  EXPECT_EQ(score.gt_two_hand.hands, 2);
+  EXPECT_EQ(score.gt_two_hand.found, 1);
+  EXPECT_EQ(score.gt_all.handedness_n, 2);
+  EXPECT_EQ(score.gt_all.handedness_correct, 1);
+  EXPECT_EQ(score.gt_all.handedness_source_n, 1);
+  EXPECT_DOUBLE_EQ(*score.stills_median_ms, 5.0);
+  EXPECT_NE(FormatTable(score).find("GT overall"), std::string::npos);
+  EXPECT_EQ(ToJson(score)["overall"]["gt_all"]["found"], 3);
+}
+
+TEST(RealScoreTest, PaMpjpeAndFingerStatesCompareTheShapeOnly) {
+  const auto dir = testing::ScratchDir();
+  Random random(testing::kTestSeed);
+  nlohmann::json truth = nlohmann::json::array(), moved = nlohmann::json::array();
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    const Eigen::Vector3d p(random.Uniform(-0.1, 0.1), random.Uniform(-0.1, 0.1), random.Uniform(0.4, 0.5));
+    const Eigen::Vector3d q = 2.0 * turn * p + Eigen::Vector3d(1, 2, 3);
+    truth.push_back({p.x(), p.y(), p.z()});
+    moved.push_back({q.x(), q.y(), q.z()});
+  }
+  const nlohmann::json points = Keypoints(50, 50);
+  Write(dir / "labels.jsonl", {{{"file", "images/interhand_1.jpg"}, {"hand", "left"}, {"keypoints_2d_px", points},
+                                {"keypoints_3d_camera_m", truth}}});
+  Write(dir / "predictions.jsonl", {{{"file", "images/interhand_1.jpg"},
+                                     {"hands", {{{"keypoints_2d_px", points}, {"keypoints_3d", moved}}}}}});
+  const std::vector<RealLabel> labels = ReadRealLabels(dir / "labels.jsonl");
+  const RealScore score = ScoreReal(labels, ReadRealPredictions(dir / "predictions.jsonl", labels));
+  EXPECT_NEAR(*score.hands[0].pa_mpjpe_mm, 0.0, 1e-6);
+  EXPECT_EQ(*score.hands[0].finger_agree, 4);
+  EXPECT_EQ(score.gt_all.finger_total, 4);
+  EXPECT_FALSE(score.hands[0].handedness_ok.has_value()) << "no side predicted";
+}
+
+TEST(RealScoreTest, MalformedLabelsAndPredictionsAreRefusedByLine) {
+  const auto dir = testing::ScratchDir();
+  const nlohmann::json good = {{"file", "images/freihand_1.jpg"}, {"hand", "right"}, {"keypoints_2d_px", Keypoints(0, 0)}};
+  const auto refused = [&](const std::vector<nlohmann::json>& lines, const std::string& needle) {
+    Write(dir / "labels.jsonl", lines);
+    testing::ExpectError([&] { ReadRealLabels(dir / "labels.jsonl"); }, needle);
+  };
+  refused({good, {{"hand", "right"}}}, "labels.jsonl: line 2: no 'file'");
+  refused({good, good, {{"file", "x.jpg"}, {"keypoints_2d_px", {{1, 2}}}}}, "line 3: keypoints_2d_px must hold 21");
+  refused({{{"file", "x.jpg"}, {"hand", "both"}, {"keypoints_2d_px", Keypoints(0, 0)}}}, "line 1: hand must be");
+  refused({{{"file", "x.jpg"}}}, "line 1: has neither keypoints_2d_px nor bbox_px");
+  refused({{{"file", "x.jpg"}, {"frame", -3}, {"bbox_px", {0, 0, 1, 1}}}}, "line 1: 'frame' must be a frame number");
+  {
+    std::ofstream(dir / "labels.jsonl") << good.dump() << "\n{not json\n";
+  }
+  testing::ExpectError([&] { ReadRealLabels(dir / "labels.jsonl"); }, "line 2 is not a JSON object");
+  Write(dir / "labels.jsonl", {good});
+  const std::vector<RealLabel> labels = ReadRealLabels(dir / "labels.jsonl");
+  Write(dir / "p.jsonl", {{{"file", "images/other.jpg"}, {"hands", nlohmann::json::array()}}});
+  testing::ExpectError([&] { ReadRealPredictions(dir / "p.jsonl", labels); }, "p.jsonl: line 1: file 'images/other.jpg' matches no labelled image");
+  Write(dir / "p.jsonl", {{{"file", "freihand_1"}}, {{"file", "images/freihand_1.jpg"}}});
+  testing::ExpectError([&] { ReadRealPredictions(dir / "p.jsonl", labels); }, "line 2: a second prediction");
+}
+
+// real-dev's folder: $NPHAND_REAL_DEV, or ../shared/real-dev beside the clone.
+std::filesystem::path RealDev() {
+  if (const char* env = std::getenv("NPHAND_REAL_DEV"); env != nullptr && *env != '\0') return env;
+  return NPHAND_REAL_DEV;
+}
+
+// Predictions made from the labels themselves, deterministically spoiled: joints moved by
+// noise of several sizes, some hands dropped, some moved off, sides flipped, an extra hand,
+// 3D bent; so that every measure and every matching rule has work.
+std::vector<RealPrediction> SpoiledPredictions(const std::vector<RealLabel>& labels) {
+  Random random(testing::kTestSeed);
+  std::map<std::pair<std::string, int>, RealPrediction> by_key;
+  for (const RealLabel& label : labels) {
+    RealPrediction& p = by_key[label.key()];
+    p.file = label.file;
+    p.frame = label.frame;
+    p.ms = random.Uniform(1.0, 9.0);
+    if (random.Uniform() < 0.15) continue;  // not found
+    PredictedHand hand;
+    const double noise = label.diag * std::vector<double>{0.02, 0.08, 0.15, 0.4}[random.UniformIndex(4)];
+    const Eigen::Vector2d centre((label.box[0] + label.box[2]) / 2, (label.box[1] + label.box[3]) / 2);
+    const Eigen::Vector2d away = random.Uniform() < 0.1 ? Eigen::Vector2d(3.0 * label.diag, 0.0) : Eigen::Vector2d::Zero();
+    for (int k = 0; k < kNumKeypoints; ++k) {
+      const Eigen::Vector2d base = label.keypoints_2d[k].value_or(centre);
+      hand.keypoints_2d[k] = base + away + noise * Eigen::Vector2d(random.Normal(), random.Normal());
+    }
+    if (label.keypoints_3d.has_value()) {
+      Keypoints3d k3 = *label.keypoints_3d;
+      for (Eigen::Vector3d& q : k3) q += 0.01 * Eigen::Vector3d(random.Normal(), random.Normal(), random.Normal());
+      hand.keypoints_3d = k3;
+    }
+    if (random.Uniform() < 0.8) hand.hand = random.Uniform() < 0.8 ? label.hand : (label.hand == "left" ? "right" : "left");
+    p.hands.push_back(hand);
+    if (random.Uniform() < 0.05) {
+      PredictedHand extra = hand;
+      for (Eigen::Vector2d& q : extra.keypoints_2d) q += Eigen::Vector2d(5.0 * label.diag, 5.0 * label.diag);
+      p.hands.push_back(extra);
+    }
+  }
+  std::vector<RealPrediction> predictions;
+  for (auto& [key, p] : by_key) {
+    if (random.Uniform() < 0.03) continue;  // not run
+    predictions.push_back(std::move(p));
+  }
+  return predictions;
+}
+
+void ExpectSame(const nlohmann::json& ours, const nlohmann::json& reference, const std::string& where) {
+  for (const auto& [key, value] : reference.items()) {
+    if (!ours.contains(key)) continue;  // the reference reports more than these figures
+    const nlohmann::json& mine = ours[key];
+    if (value.is_null() || value.is_string() || value.is_boolean()) {
+      EXPECT_EQ(mine, value) << where << " " << key;
+    } else if (value.is_number()) {
+      // The reference rounds per-hand figures (errors to 1e-6, pixels and mm to 1e-3).
+      EXPECT_NEAR(mine.get<double>(), value.get<double>(), key.find("px") != std::string::npos || key.find("mm") != std::string::npos ? 2e-3 : 2e-6)
+          << where << " " << key;
+    }
+  }
+}
+
+TEST(RealScoreTest, FiguresAreTheReferenceScorersOnTheSamePredictions) {
+  const std::filesystem::path dev = RealDev();
+  if (!std::filesystem::exists(dev / "labels.jsonl") || !std::filesystem::exists(dev / "score_realdev.py")) {
+    GTEST_SKIP() << dev << " is not here (real-dev is not shipped with nphand)";
+  }
+  if (std::system("python3 -c 'import statistics' >/dev/null 2>&1") != 0) GTEST_SKIP() << "no python3 for the reference";
+  const auto dir = testing::ScratchDir();
+  const std::vector<RealLabel> labels = ReadRealLabels(dev / "labels.jsonl");
+  EXPECT_EQ(labels.size(), 390u);
+  const std::vector<RealPrediction> predictions = SpoiledPredictions(labels);
+  {
+    std::ofstream out(dir / "predictions.jsonl");
+    for (const RealPrediction& p : predictions) out << ToJson(p).dump() << "\n";
+  }
+  const std::string command = "python3 '" + (dev / "score_realdev.py").string() + "' --labels '" + (dev / "labels.jsonl").string() +
+                              "' --pred '" + (dir / "predictions.jsonl").string() + "' --out-json '" +
+                              (dir / "reference.json").string() + "' --out-table /dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  nlohmann::json reference;
+  std::ifstream(dir / "reference.json") >> reference;
+  const nlohmann::json run = reference["runs"][0];
+  const nlohmann::json ours = ToJson(ScoreReal(labels, ReadRealPredictions(dir / "predictions.jsonl", labels)));
+  for (const auto& [source, figures] : run["per_source"].items()) {
+    ASSERT_TRUE(ours["per_source"].contains(source)) << source;
+    ExpectSame(ours["per_source"][source], figures, source);
+  }
+  for (const char* part : {"gt_all", "gt_one_hand_images", "gt_two_hand_images"}) {
+    ExpectSame(ours["overall"][part], run["overall"][part], part);
+  }
+  EXPECT_NEAR(ours["timing"]["stills_median_ms"].get<double>(), run["timing"]["stills"]["median_ms"].get<double>(), 1e-9);
+  EXPECT_NEAR(ours["timing"]["video_median_ms"].get<double>(), run["timing"]["video_frames"]["median_ms"].get<double>(), 1e-9);
+  ASSERT_EQ(ours["per_hand"].size(), run["per_hand"].size());
+  for (size_t i = 0; i < run["per_hand"].size(); ++i) {
+    EXPECT_EQ(ours["per_hand"][i]["found"], run["per_hand"][i]["found"]) << i;
+  }
+}
+
+}  // namespace
+}  // namespace nphand
