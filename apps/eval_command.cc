@@ -3,6 +3,7 @@
 #include <chrono>
 #include <iostream>
 
+#include "nphand/eval/real_eval.h"
 #include "nphand/render/draw.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
@@ -98,6 +99,43 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
     WriteFileAtomic(options.out_dir / (options.name + ".json"), json.dump(2) + "\n");
   }
   return scores;
+}
+
+EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* progress) {
+  NPHAND_THROW_CHECK(!options.labels.empty(), "eval real: --labels is required (e.g. ../shared/real-dev/labels.jsonl)");
+  const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+  if (!options.out_dir.empty()) {
+    CheckOutputFolder(options.out_dir, "eval real --out");
+    CheckOutputsApart({{options.labels, "--labels"}, {options.db, "--db"}, {index_path, "--index"}},
+                      {{options.out_dir, "eval real --out", {".json", ".jsonl", ".png"}}});
+  }
+  const std::vector<RealLabel> labels = ReadRealLabels(options.labels);
+  const std::filesystem::path root = options.labels.has_parent_path() ? options.labels.parent_path() : ".";
+  CheckRealFiles(labels, root);
+  const Database db = Database::Open(options.db);
+  const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
+  const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
+  EstimatorOptions estimator_options;
+  if (!options.faces) estimator_options.skin.face_cascade.clear();
+  Estimator right(db, *index, hand, estimator_options);
+  estimator_options.hand = Handedness::kLeft;
+  Estimator left(db, *index, hand, estimator_options);
+  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, &left, progress);
+  const RealScore score = ScoreReal(labels, predictions);
+  EvalRealResult result{ToJson(score), FormatTable(score)};
+  result.figures["labels"] = options.labels.string();
+  result.figures["database"] = options.db.filename().string();
+  result.figures["index"] = index->Backend();
+  result.figures["hand"] = "given";
+  result.figures["machine"] = MachineDescription();
+  if (!options.out_dir.empty()) {
+    std::string lines;
+    for (const RealPrediction& p : predictions) lines += ToJson(p).dump() + "\n";
+    WriteFileAtomic(options.out_dir / "real_predictions.jsonl", lines);
+    WriteFileAtomic(options.out_dir / "real.json", result.figures.dump(2) + "\n");
+    WriteImageAtomic(options.out_dir / "real_contact.png", RealContactSheet(labels, predictions, score, root));
+  }
+  return result;
 }
 
 namespace {

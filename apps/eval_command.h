@@ -68,6 +68,24 @@ PoseStudyResult RunEvalPoseStudy(PoseStudyPart part, const EvalPoseStudyCommandO
 // and evaluation.json: what ran, how long each part took, on what machine.
 nlohmann::json RunEvalAll(const EvalPoseStudyCommandOptions& options);
 
+// `nphand eval real`: the estimator on labelled real images and video (real-dev's format),
+// scored as real-dev's reference scorer does (eval/real_score.h).
+struct EvalRealCommandOptions {
+  std::filesystem::path labels;   // labels.jsonl; the files it names are relative to its folder
+  std::filesystem::path db = "out/nphand.db";
+  std::filesystem::path index;    // default: the database's path + ".idx"
+  std::filesystem::path asset_dir = DefaultAssetDir();
+  std::filesystem::path out_dir;  // if set: real.json, real_predictions.jsonl, real_contact.png there
+  bool faces = true;              // set faces aside (OpenCV's cascade)
+};
+
+struct EvalRealResult {
+  nlohmann::json figures;  // eval/real_score.h's ToJson, with the run's settings
+  std::string table;
+};
+
+EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* progress);
+
 // The estimator's validation sweep (docs/estimator.md).
 std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& options);
 

@@ -387,6 +387,22 @@ void AddEvalPosesCommand(CLI::App* eval, nphand::EvalPosesCommandOptions& o, boo
   });
 }
 
+void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool& json) {
+  CLI::App* cmd = eval->add_subcommand(
+      "real", "The estimator on labelled real images and video (real-dev's labels.jsonl), scored as real-dev's reference does");
+  cmd->add_option("--labels", o.labels, "labels.jsonl (its files are relative to its folder)")->required();
+  cmd->add_option("--db", o.db, "Database file")->capture_default_str();
+  cmd->add_option("--index", o.index, "Index file (default: the database's path + .idx)");
+  cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+  cmd->add_option("--out", o.out_dir, "Folder for real.json, real_predictions.jsonl and real_contact.png");
+  cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
+  cmd->add_flag("--json", json, "Print JSON instead of the table");
+  cmd->callback([&o, &json]() {
+    const nphand::EvalRealResult result = nphand::RunEvalReal(o, &std::cerr);
+    std::cout << (json ? Dump(result.figures) + "\n" : result.table);
+  });
+}
+
 void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOptions& o, bool& json) {
   const auto add = [&](const char* name, const char* help) {
     CLI::App* cmd = eval->add_subcommand(name, help);
@@ -439,10 +455,11 @@ void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOption
 
 void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, nphand::EvalAnnCommandOptions& ann,
                     nphand::EvalEstimatorCommandOptions& estimator, nphand::EvalPosesCommandOptions& poses,
-                    nphand::EvalPoseStudyCommandOptions& study, bool& json) {
-  CLI::App* eval = app.add_subcommand("eval", "The paper's experiments");
+                    nphand::EvalPoseStudyCommandOptions& study, nphand::EvalRealCommandOptions& real, bool& json) {
+  CLI::App* eval = app.add_subcommand("eval", "The paper's experiments, and nphand on real images");
   eval->require_subcommand(1);
   AddEvalPosesCommand(eval, poses, json);
+  AddEvalRealCommand(eval, real, json);
   AddEvalAnnCommand(eval, ann, json);
   AddEvalEstimatorCommand(eval, estimator, json);
   AddEvalPoseStudyCommands(eval, study, json);
@@ -516,7 +533,9 @@ int main(int argc, char** argv) {
   nphand::EvalEstimatorCommandOptions estimator_study_options;
   nphand::EvalPosesCommandOptions poses_options;
   nphand::EvalPoseStudyCommandOptions pose_study_options;
-  AddEvalCommand(app, eval_options, ann_options, estimator_study_options, poses_options, pose_study_options, json);
+  nphand::EvalRealCommandOptions real_options;
+  AddEvalCommand(app, eval_options, ann_options, estimator_study_options, poses_options, pose_study_options, real_options,
+                 json);
   try {
     CheckSubcommands(app, argc, argv);
     app.parse(argc, argv);

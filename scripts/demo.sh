@@ -60,7 +60,15 @@ echo "demo: estimating its poses"
   --out "$out/poses.jsonl" --overlay "$out/overlay.mp4"
 echo "demo: errors against the ground truth"
 "$nphand" eval poses --truth "$seq/truth.jsonl" --poses "$out/poses.jsonl" --out "$out" --name errors
+realdev="$root/../shared/real-dev"
+if [ -f "$realdev/labels.jsonl" ]; then
+  echo "demo: real photographs and video (real-dev, its labelled hand sides given), scored as real-dev's reference does"
+  "$nphand" eval real --labels "$realdev/labels.jsonl" --out "$out"
+else
+  echo "demo: skipping nphand eval real: $realdev is not here (real-dev is not shipped with nphand)"
+fi
 echo "demo: done; images in $out"
 echo "  poses:   $out/poses.jsonl (docs/FORMAT.md)"
 echo "  overlay: $out/overlay.mp4"
 echo "  errors:  $out/errors.png, $out/errors.json"
+if [ -f "$realdev/labels.jsonl" ]; then echo "  real:    $out/real.json, $out/real_contact.png"; fi

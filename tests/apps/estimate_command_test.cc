@@ -17,6 +17,7 @@
 #include "apps/sequence_command.h"
 #include "nphand/util/check.h"
 #include "testing/testing.h"
+#include "tests/apps/command_fixture.h"
 #include "testing/tiny_db.h"
 
 namespace nphand {
@@ -34,24 +35,7 @@ std::vector<nlohmann::json> Lines(const std::filesystem::path& path) {
 class EstimateCommandTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new std::filesystem::path(std::filesystem::temp_directory_path() /
-                                     ("nphand_estimate_command_" + std::to_string(::getpid())));
-    std::filesystem::remove_all(*dir_);
-    std::filesystem::create_directories(*dir_);
-    testing::BuildTinyDatabase(*dir_ / "tiny.db");
-    IndexBuildCommandOptions index;
-    index.db = *dir_ / "tiny.db";
-    index.index = IndexOptions::Exact();
-    RunIndexBuild(index);
-    SequenceCommandOptions sequence;
-    sequence.sequence.frames = 5;
-    sequence.sequence.width = 240;
-    sequence.sequence.height = 180;
-    sequence.sequence.grasp = 1;
-    sequence.sequence.distance_m = 0.3;
-    sequence.video = true;
-    sequence.out_dir = *dir_ / "sequence";
-    RunSequence(sequence, nullptr);
+    dir_ = new std::filesystem::path(testing::MakeCommandFixture("nphand_estimate_command", 5));
   }
   static void TearDownTestSuite() {
     std::filesystem::remove_all(*dir_);
@@ -176,6 +160,56 @@ TEST_F(EstimateCommandTest, BadInputsGiveTheirErrors) {
   eval.truth = *dir_ / "sequence" / "truth.jsonl";
   eval.poses = *dir_ / "broken.jsonl";
   testing::ExpectError([&] { RunEvalPoses(eval); }, "has no valid 'joint_angles_deg'");
+}
+
+// `nphand eval real` end to end, on labels in real-dev's format made from the rendered
+// sequence's truth: three frames as stills and the video's frames in order.
+TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles) {
+  const std::filesystem::path root = *dir_ / "real";
+  std::filesystem::create_directories(root / "images");
+  std::filesystem::create_directories(root / "videos");
+  std::filesystem::copy_file(*dir_ / "sequence" / "video.mp4", root / "videos" / "clip.mp4",
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::vector<nlohmann::json> truth = Lines(*dir_ / "sequence" / "truth.jsonl");
+  {
+    std::ofstream labels(root / "labels.jsonl");
+    for (int i = 0; i < 3; ++i) {
+      const std::string name = cv::format("images/freihand_%d.png", i);
+      std::filesystem::copy_file(*dir_ / "sequence" / "frames" / cv::format("%06d.png", i), root / name,
+                                 std::filesystem::copy_options::overwrite_existing);
+      labels << nlohmann::json({{"file", name}, {"hand", "right"}, {"hand_side_by", "source"},
+                                {"keypoints_2d_px", truth[i]["keypoints_2d_px"]}}).dump() << "\n";
+    }
+    for (int i = 0; i < 5; ++i) {
+      labels << nlohmann::json({{"file", "videos/clip.mp4"}, {"frame", i}, {"hand", "right"},
+                                {"keypoints_2d_px", truth[i]["keypoints_2d_px"]}}).dump() << "\n";
+    }
+  }
+  EvalRealCommandOptions options;
+  options.labels = root / "labels.jsonl";
+  options.db = *dir_ / "tiny.db";
+  options.out_dir = *dir_ / "real_out";
+  options.faces = false;
+  const EvalRealResult result = RunEvalReal(options, nullptr);
+  EXPECT_EQ(result.figures["per_source"]["freihand"]["hands"], 3);
+  EXPECT_EQ(result.figures["per_source"]["asl_video"]["hands"], 5);
+  EXPECT_EQ(result.figures["per_hand"].size(), 8u);
+  EXPECT_EQ(result.figures["hand"], "given");
+  EXPECT_NE(result.table.find("GT overall"), std::string::npos);
+  for (const char* file : {"real.json", "real_predictions.jsonl", "real_contact.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(options.out_dir / file)) << file;
+  }
+  EXPECT_EQ(Lines(options.out_dir / "real_predictions.jsonl").size(), 8u) << "a line per labelled image and frame";
+  // A label naming a missing image is refused by name before any work; so is an output
+  // folder that holds the labels.
+  {
+    std::ofstream(root / "labels.jsonl", std::ios::app)
+        << nlohmann::json({{"file", "images/gone.png"}, {"bbox_px", {0, 0, 10, 10}}}).dump() << "\n";
+  }
+  testing::ExpectError([&] { RunEvalReal(options, nullptr); }, "labels line 9: " + (root / "images" / "gone.png").string() + ": no such file");
+  std::filesystem::copy_file(root / "labels.jsonl", options.out_dir / "labels.jsonl");
+  options.labels = options.out_dir / "labels.jsonl";
+  testing::ExpectError([&] { RunEvalReal(options, nullptr); }, "lies in eval real --out");
 }
 
 TEST_F(EstimateCommandTest, ReuseKeepsAMatchingDatabaseAndIndex) {

@@ -27,6 +27,7 @@
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
 #include "testing/testing.h"
+#include "tests/apps/command_fixture.h"
 #include "testing/tiny_db.h"
 
 namespace nphand {
@@ -133,24 +134,7 @@ bool WaitForLines(const std::filesystem::path& path, size_t lines) {
 class EstimateHardeningTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new std::filesystem::path(std::filesystem::temp_directory_path() /
-                                     ("nphand_estimate_hardening_" + std::to_string(::getpid())));
-    std::filesystem::remove_all(*dir_);
-    std::filesystem::create_directories(*dir_);
-    testing::BuildTinyDatabase(*dir_ / "tiny.db");
-    IndexBuildCommandOptions index;
-    index.db = *dir_ / "tiny.db";
-    index.index = IndexOptions::Exact();
-    RunIndexBuild(index);
-    SequenceCommandOptions sequence;
-    sequence.sequence.frames = 24;
-    sequence.sequence.width = 240;
-    sequence.sequence.height = 180;
-    sequence.sequence.grasp = 1;
-    sequence.sequence.distance_m = 0.3;
-    sequence.video = true;
-    sequence.out_dir = *dir_ / "sequence";
-    RunSequence(sequence, nullptr);
+    dir_ = new std::filesystem::path(testing::MakeCommandFixture("nphand_estimate_hardening", 24));
     std::filesystem::create_directories(LongInput());
     for (size_t i = 0; i < kLongFrames; ++i) {
       std::filesystem::create_hard_link(Frames() / cv::format("%06zu.png", i % 24), LongInput() / cv::format("%06zu.png", i));

@@ -511,9 +511,9 @@ std::string FormatTable(const RealScore& score) {
     s << std::fixed << std::setprecision(precision) << *v;
     return s.str();
   };
-  out << std::left << std::setw(20) << "source" << std::right << std::setw(6) << "hands" << std::setw(11) << "found"
+  out << std::left << std::setw(20) << "source" << std::right << std::setw(6) << "hands" << std::setw(12) << "found"
       << std::setw(10) << "PCK.1 fnd" << std::setw(10) << "PCK.2 fnd" << std::setw(10) << "PCK.2 all" << std::setw(9)
-      << "err/diag" << std::setw(10) << "handed." << std::setw(14) << "PA-MPJPE" << std::setw(10) << "fingers" << std::setw(6)
+      << "err/diag" << std::setw(11) << "handed." << std::setw(18) << "PA-MPJPE" << std::setw(10) << "fingers" << std::setw(6)
       << "extra" << "\n";
   const auto row = [&](const std::string& name, const RealAggregate& a) {
     const std::string found = std::to_string(a.found) + " " + figure(a.found_rate().has_value() ? std::optional(100.0 * *a.found_rate()) : std::nullopt, 0) + "%";
@@ -522,9 +522,9 @@ std::string FormatTable(const RealScore& score) {
                                                            std::to_string(a.hands_with_3d_label) + ")"
                                                      : "-";
     const std::string fingers = a.finger_total > 0 ? std::to_string(a.finger_agree) + "/" + std::to_string(a.finger_total) : "-";
-    out << std::left << std::setw(20) << name << std::right << std::setw(6) << a.hands << std::setw(11) << found << std::setw(10)
+    out << std::left << std::setw(20) << name << std::right << std::setw(6) << a.hands << std::setw(12) << found << std::setw(10)
         << figure(a.pck_01_found) << std::setw(10) << figure(a.pck_02_found) << std::setw(10) << figure(a.pck_02_all)
-        << std::setw(9) << figure(a.mean_norm_err_found) << std::setw(10) << handed << std::setw(14) << pa << std::setw(10)
+        << std::setw(9) << figure(a.mean_norm_err_found) << std::setw(11) << handed << std::setw(18) << pa << std::setw(10)
         << fingers << std::setw(6) << a.extra << "\n";
   };
   out << "-- ground-truth labels\n";

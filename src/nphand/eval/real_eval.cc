@@ -1,0 +1,184 @@
+#include "nphand/eval/real_eval.h"
+
+#include <map>
+#include <set>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "nphand/render/draw.h"
+#include "nphand/util/check.h"
+#include "nphand/util/progress.h"
+
+namespace nphand {
+namespace {
+
+// Reads a still as 8-bit BGR; an image with transparency is laid on white, as a viewer
+// shows it (a cut-out's hidden pixels are often black or arbitrary).
+cv::Mat ReadStill(const std::filesystem::path& path) {
+  const cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  NPHAND_THROW_CHECK(!raw.empty(), path.string(), ": cannot read this image");
+  cv::Mat eight;
+  if (raw.depth() == CV_16U) {
+    raw.convertTo(eight, CV_8U, 1.0 / 257.0);
+  } else {
+    eight = raw;
+  }
+  cv::Mat bgr;
+  if (eight.channels() == 1) {
+    cv::cvtColor(eight, bgr, cv::COLOR_GRAY2BGR);
+  } else if (eight.channels() == 4) {
+    bgr.create(eight.size(), CV_8UC3);
+    for (int y = 0; y < eight.rows; ++y) {
+      for (int x = 0; x < eight.cols; ++x) {
+        const cv::Vec4b p = eight.at<cv::Vec4b>(y, x);
+        const int a = p[3];
+        for (int c = 0; c < 3; ++c) bgr.at<cv::Vec3b>(y, x)[c] = static_cast<uchar>((p[c] * a + 255 * (255 - a) + 127) / 255);
+      }
+    }
+  } else {
+    bgr = eight;
+  }
+  return bgr;
+}
+
+PredictedHand HandOf(const FrameResult& result, Handedness side) {
+  PredictedHand hand;
+  hand.keypoints_2d = result.keypoints_2d;
+  hand.keypoints_3d = result.keypoints_hand;
+  hand.hand = side == Handedness::kRight ? "right" : "left";
+  return hand;
+}
+
+}  // namespace
+
+void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem::path& root) {
+  std::set<std::string> checked;
+  for (const RealLabel& label : labels) {
+    if (!checked.insert(label.file).second) continue;
+    const std::filesystem::path path = root / label.file;
+    std::error_code ec;
+    NPHAND_THROW_CHECK(std::filesystem::is_regular_file(path, ec), "labels line ", label.line + 1, ": ", path.string(),
+                       ": no such file");
+    if (label.frame.has_value()) {
+      cv::VideoCapture video(path.string(), cv::CAP_FFMPEG);
+      NPHAND_THROW_CHECK(video.isOpened(), path.string(), ": cannot read this as a video");
+    } else {
+      NPHAND_THROW_CHECK(cv::haveImageReader(path.string()), path.string(), ": not an image OpenCV can read");
+    }
+  }
+}
+
+std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, const std::filesystem::path& root,
+                                         Estimator* right, Estimator* left, std::ostream* progress) {
+  // Images and videos in the order of their first label; the sides labelled in each.
+  std::vector<std::string> stills, videos;
+  std::map<std::string, std::set<std::string>> sides;
+  std::map<std::string, std::set<int>> frames;
+  for (const RealLabel& label : labels) {
+    std::vector<std::string>& list = label.frame.has_value() ? videos : stills;
+    if (std::find(list.begin(), list.end(), label.file) == list.end()) list.push_back(label.file);
+    sides[label.file].insert(label.hand.empty() ? "right" : label.hand);
+    if (label.frame.has_value()) frames[label.file].insert(*label.frame);
+  }
+  uint64_t total = stills.size();
+  for (const std::string& video : videos) total += static_cast<uint64_t>(*frames[video].rbegin() + 1);
+  ProgressLine line(progress, "eval real", total, "images");
+  uint64_t done = 0;
+  std::vector<RealPrediction> predictions;
+  for (const std::string& file : stills) {
+    const cv::Mat bgr = ReadStill(root / file);
+    RealPrediction prediction;
+    prediction.file = file;
+    prediction.ms = 0.0;
+    for (const std::string& side : sides[file]) {
+      Estimator* estimator = side == "left" ? left : right;
+      estimator->Reset();
+      const FrameResult result = estimator->Process(bgr, 0.0);
+      *prediction.ms += result.ms.total;
+      if (result.detected()) prediction.hands.push_back(HandOf(result, estimator->options().hand));
+    }
+    predictions.push_back(std::move(prediction));
+    line.Update(++done);
+  }
+  for (const std::string& file : videos) {
+    // One side per video: the first labelled.
+    Estimator* estimator = *sides[file].begin() == "left" ? left : right;
+    estimator->Reset();
+    cv::VideoCapture video((root / file).string(), cv::CAP_FFMPEG);
+    NPHAND_THROW_CHECK(video.isOpened(), (root / file).string(), ": cannot read this as a video");
+    const double fps = video.get(cv::CAP_PROP_FPS) > 0.0 ? video.get(cv::CAP_PROP_FPS) : 25.0;
+    const int last = *frames[file].rbegin();
+    cv::Mat bgr;
+    for (int frame = 0; frame <= last; ++frame) {
+      NPHAND_THROW_CHECK(video.read(bgr) && !bgr.empty(), (root / file).string(), ": ends at frame ", frame,
+                         ", but frames up to ", last, " are labelled");
+      const FrameResult result = estimator->Process(bgr, frame / fps);
+      if (frames[file].count(frame)) {
+        RealPrediction prediction;
+        prediction.file = file;
+        prediction.frame = frame;
+        prediction.ms = result.ms.total;
+        if (result.detected()) prediction.hands.push_back(HandOf(result, estimator->options().hand));
+        predictions.push_back(std::move(prediction));
+      }
+      line.Update(++done);
+    }
+  }
+  line.Finish();
+  return predictions;
+}
+
+cv::Mat RealContactSheet(const std::vector<RealLabel>& labels, const std::vector<RealPrediction>& predictions,
+                         const RealScore& score, const std::filesystem::path& root) {
+  constexpr int kTile = 240, kCaption = 18, kColumns = 8;
+  std::vector<std::string> stills;
+  for (const RealLabel& label : labels) {
+    if (!label.frame.has_value() && std::find(stills.begin(), stills.end(), label.file) == stills.end()) stills.push_back(label.file);
+  }
+  const int rows = (static_cast<int>(stills.size()) + kColumns - 1) / kColumns;
+  cv::Mat sheet(std::max(1, rows) * (kTile + kCaption), kColumns * kTile, CV_8UC3, cv::Scalar(24, 24, 24));
+  for (size_t i = 0; i < stills.size(); ++i) {
+    const std::string& file = stills[i];
+    const cv::Mat image = ReadStill(root / file);
+    const double scale = std::min(static_cast<double>(kTile) / image.cols, static_cast<double>(kTile) / image.rows);
+    const cv::Size size(std::max(1, static_cast<int>(image.cols * scale)), std::max(1, static_cast<int>(image.rows * scale)));
+    cv::Mat tile(kTile, kTile, CV_8UC3, cv::Scalar(24, 24, 24));
+    const cv::Point offset((kTile - size.width) / 2, (kTile - size.height) / 2);
+    cv::resize(image, tile(cv::Rect(offset, size)), size, 0, 0, cv::INTER_AREA);
+    const auto place = [&](const Eigen::Vector2d& p) { return Eigen::Vector2d(p.x() * scale + offset.x, p.y() * scale + offset.y); };
+    int found = 0, hands = 0;
+    for (const RealHandScore& r : score.hands) {
+      if (r.label->file != file || r.label->frame.has_value()) continue;
+      ++hands;
+      found += r.found;
+      const cv::Scalar green(80, 220, 80);
+      if (r.label->labelled.empty()) {
+        const Eigen::Vector2d a = place({r.label->box[0], r.label->box[1]}), b = place({r.label->box[2], r.label->box[3]});
+        cv::rectangle(tile, cv::Point(int(a.x()), int(a.y())), cv::Point(int(b.x()), int(b.y())), green, 1);
+      }
+      for (int k : r.label->labelled) {
+        const Eigen::Vector2d p = place(*r.label->keypoints_2d[k]);
+        cv::circle(tile, cv::Point(int(p.x()), int(p.y())), 3, green, 1, cv::LINE_AA);
+      }
+    }
+    for (const RealPrediction& p : predictions) {
+      if (p.file != file || p.frame.has_value()) continue;
+      for (const PredictedHand& hand : p.hands) {
+        std::array<Eigen::Vector2d, kNumKeypoints> placed;
+        for (int k = 0; k < kNumKeypoints; ++k) placed[k] = place(hand.keypoints_2d[k]);
+        DrawKeypoints2d(placed, &tile);
+      }
+    }
+    const int x = static_cast<int>(i % kColumns) * kTile, y = static_cast<int>(i / kColumns) * (kTile + kCaption);
+    tile.copyTo(sheet(cv::Rect(x, y, kTile, kTile)));
+    const std::string caption = std::filesystem::path(file).stem().string().substr(0, 22) + " " + std::to_string(found) + "/" +
+                                std::to_string(hands);
+    cv::putText(sheet, caption, cv::Point(x + 4, y + kTile + 13), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                found == hands ? cv::Scalar(200, 255, 200) : cv::Scalar(120, 120, 255), 1, cv::LINE_AA);
+  }
+  return sheet;
+}
+
+}  // namespace nphand

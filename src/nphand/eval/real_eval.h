@@ -1,0 +1,37 @@
+// `nphand eval real`: the estimator on labelled real photographs and video (real-dev, or
+// any labels.jsonl in its format), scored by real_score.h. Stills are estimated one at a
+// time from a fresh estimator (no temporal prior); a video's frames in order, so that the
+// prior applies.
+#pragma once
+
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "nphand/estimate/estimator.h"
+#include "nphand/eval/real_score.h"
+
+namespace nphand {
+
+// Checks that every file the labels name is under `root` and readable as what it is (an
+// image, or a video for lines with a frame); throws nphand::Error naming the first that is
+// not, before any estimation.
+void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem::path& root);
+
+// The estimator's predictions for every labelled image and video frame. The hand's side is
+// the label's ("given"): each side labelled in an image is estimated once, by `right` or
+// `left` (estimators over one database, differing in their `hand`), each reset first; an
+// image without a labelled side is estimated as a right hand. `progress` (if not null)
+// gets a progress line.
+std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, const std::filesystem::path& root,
+                                         Estimator* right, Estimator* left, std::ostream* progress);
+
+// A contact sheet of the stills: each image with its labelled keypoints (green rings; a
+// HaGRID box as a green rectangle) and the predicted skeletons, captioned found or missed.
+cv::Mat RealContactSheet(const std::vector<RealLabel>& labels, const std::vector<RealPrediction>& predictions,
+                         const RealScore& score, const std::filesystem::path& root);
+
+}  // namespace nphand
