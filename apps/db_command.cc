@@ -1,10 +1,12 @@
 #include "apps/db_command.h"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <tuple>
 #include <iostream>
 
+#include "nphand/features/crop.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
 
@@ -68,6 +70,17 @@ nlohmann::json RunDbInfo(const std::filesystem::path& path) {
   const Database db = Database::Open(path);
   const double open_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   nlohmann::json info = DescribeDatabase(db);
+  // How thin a hand's silhouette can be: what the estimator's max_elongation rests on.
+  std::vector<double> elongation;
+  for (size_t i = 0; i < db.size(); ++i) {
+    if (db.Meta(i).has_hand) elongation.push_back(Elongation(db.Crop(i)));
+  }
+  std::sort(elongation.begin(), elongation.end());
+  if (!elongation.empty()) {
+    const auto quantile = [&](double q) { return elongation[std::min(elongation.size() - 1, static_cast<size_t>(q * elongation.size()))]; };
+    info["silhouette_elongation"] = {{"median", quantile(0.5)}, {"q99", quantile(0.99)}, {"q999", quantile(0.999)},
+                                     {"q9999", quantile(0.9999)}, {"max", elongation.back()}};
+  }
   info["path"] = path.string();
   info["open_seconds"] = open_seconds;
   return info;

@@ -243,8 +243,16 @@ TEST_F(EstimatorTest, FramesWithoutAHandSaySo) {
   EXPECT_EQ(r.status, FrameStatus::kNoSkin);
   EXPECT_EQ(r.reason, "only faces are skin-coloured");
   EXPECT_EQ(estimator.ProcessMask(cv::Mat::zeros(10, 10, CV_8UC1), 0.0).status, FrameStatus::kNoSkin);
+  // A sliver of skin (a neck's edge beside a face) is too thin for a hand.
+  cv::Mat sliver = wall.clone();
+  cv::rectangle(sliver, cv::Rect(150, 60, 8, 80), SkinToneByName("olive").bgr, cv::FILLED);
+  estimator.Reset();
+  r = estimator.Process(sliver, 0.0);
+  EXPECT_EQ(r.status, FrameStatus::kNotAHand);
+  EXPECT_NE(r.reason.find("too thin for a hand"), std::string::npos) << r.reason;
   // A shape no database view resembles is not a hand.
   options.max_distance = 0.05;
+  options.max_elongation = 100.0;  // the bar below is thin too; here its distance is tested
   Estimator strict(*db_, *index_, RightHand(), options);
   cv::Mat bar = cv::Mat::zeros(240, 320, CV_8UC1);
   cv::rectangle(bar, cv::Rect(20, 100, 280, 12), cv::Scalar(255), cv::FILLED);

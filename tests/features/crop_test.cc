@@ -36,6 +36,21 @@ TEST(CropTest, WindowPastTheImageIsPaddedWithBackground) {
   EXPECT_NEAR(cv::sum(crop->image)[0], 10.0 * 30.0 * (40.0 * 40.0) / (60.0 * 60.0), 1e-3);
 }
 
+TEST(CropTest, ElongationIsTheRatioOfThePrincipalAxes) {
+  cv::Mat mask = cv::Mat::zeros(100, 100, CV_8UC1);
+  EXPECT_DOUBLE_EQ(Elongation(mask), 1.0) << "empty";
+  cv::rectangle(mask, cv::Rect(40, 10, 10, 80), cv::Scalar(255), cv::FILLED);
+  EXPECT_NEAR(Elongation(mask), 8.0, 0.05);
+  cv::Mat turned = RotateMask(mask, 0.6);
+  EXPECT_NEAR(Elongation(turned), 8.0, 0.4) << "in any direction";
+  cv::Mat coverage;
+  mask.convertTo(coverage, CV_32F, 1.0 / 255.0);
+  EXPECT_NEAR(Elongation(coverage), 8.0, 0.05) << "a crop's coverage";
+  cv::Mat disk = cv::Mat::zeros(100, 100, CV_8UC1);
+  cv::circle(disk, cv::Point(50, 50), 30, cv::Scalar(255), cv::FILLED);
+  EXPECT_NEAR(Elongation(disk), 1.0, 0.02);
+}
+
 TEST(CropTest, EmptyMaskIsNoHandAndWrongInputIsRefused) {
   EXPECT_FALSE(CropHand(cv::Mat(10, 10, CV_8UC1, cv::Scalar(0))).has_value());
   EXPECT_THROW(CropHand(cv::Mat(10, 10, CV_32FC1, cv::Scalar(1))), Error);

@@ -150,6 +150,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the focal length must be >= 0 pixels (0: from the field of view) and the field of view within (1, 179) degrees";
   } else if (!(hand_length_m >= 0.05 && hand_length_m <= 0.4)) {
     *why = "the hand length must be within [0.05, 0.4] metres";
+  } else if (!(max_elongation >= 1.0)) {
+    *why = "the largest elongation must be at least 1 (a disk)";
   } else if (learn_interval < 1) {
     *why = "the learning interval must be at least 1 frame";
   } else if (!skin.Check(why) || !forearm.Check(why)) {
@@ -386,6 +388,15 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   const DescriptorConfig& config = db_.descriptor();
   const std::optional<HandCrop> crop = CropHand(hand_mask(roi), config.Crop());
   NPHAND_CHECK(crop.has_value(), "a non-empty box gave no crop");
+  const double elongation = Elongation(crop->image);
+  if (elongation > options_.max_elongation) {
+    result.status = FrameStatus::kNotAHand;
+    result.reason = "too thin for a hand (principal axes " + std::to_string(elongation) + " : 1, more than " +
+                    std::to_string(options_.max_elongation) + ")";
+    result.box = box;
+    result.ms.describe = Ms(t, Clock::now());
+    return result;
+  }
   std::vector<HandCrop> crops = {*crop};
   if (config.normalize_roll && crop->roll_skewness < options_.roll_ambiguity) crops.push_back(HalfTurn(*crop));
   std::vector<Descriptor> descriptors;

@@ -61,6 +61,10 @@ struct EstimatorOptions {
   double roll_ambiguity = 0.05;
   // No hand unless the nearest database entry is at most this far in feature space.
   double max_distance = 0.8;
+  // No hand when the silhouette's principal axes are farther apart than this ratio: a sliver
+  // of skin (a neck's edge beside a face) is no hand. The default database's silhouettes:
+  // 99.9 % at most 4.7, 99.99 % at most 5.9, the thinnest 10.0 (`nphand db info`).
+  double max_elongation = 6.0;
   Handedness hand = Handedness::kRight;         // left: mirrored into the right-hand database
   // Camera: a focal length in pixels, or (focal_px = 0) a horizontal field of view.
   double focal_px = 0.0;

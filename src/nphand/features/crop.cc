@@ -80,6 +80,14 @@ cv::Mat RotateMask(const cv::Mat& mask, double angle) {
   return turned;
 }
 
+double Elongation(const cv::Mat& coverage) {
+  const cv::Moments m = coverage.type() == CV_8UC1 ? cv::moments(coverage, true) : cv::moments(coverage);
+  if (m.m00 <= 0.0) return 1.0;
+  const double a = m.mu20 / m.m00, b = m.mu02 / m.m00, c = m.mu11 / m.m00;
+  const double spread = std::sqrt(0.25 * (a - b) * (a - b) + c * c);
+  return std::sqrt((0.5 * (a + b) + spread) / std::max(0.5 * (a + b) - spread, 1e-12));
+}
+
 double PrincipalRoll(const cv::Mat& mask, double* skewness) {
   if (skewness != nullptr) *skewness = 0.0;
   const cv::Moments m = cv::moments(mask != 0, true);

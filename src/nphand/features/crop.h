@@ -44,6 +44,10 @@ cv::Mat RotateMask(const cv::Mat& mask, double angle);
 // `skewness` is not null it receives the normalised third moment's magnitude along the axis.
 double PrincipalRoll(const cv::Mat& mask, double* skewness = nullptr);
 
+// The ratio of a silhouette's principal axes, >= 1: the square root of the ratio of its
+// second central moments' eigenvalues (a w x h rectangle: h / w). `coverage` is a mask
+// (CV_8UC1, non-zero = hand) or a crop's coverage (CV_32FC1); 1 when it is empty.
+double Elongation(const cv::Mat& coverage);
 // The crop of the non-zero pixels of `mask` (CV_8UC1); std::nullopt when the mask has none
 // ("no hand"). Throws nphand::Error for a mask of another type or invalid options.
 std::optional<HandCrop> CropHand(const cv::Mat& mask, const CropOptions& options = {});
