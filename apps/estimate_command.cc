@@ -57,10 +57,6 @@ cv::Mat Overlay(const cv::Mat& frame, const FrameResult& result, Estimator* esti
   return out;
 }
 
-}  // namespace
-
-namespace {
-
 // The overlay's frame for an image that could not be read: grey, with why.
 cv::Mat UnreadablePicture(cv::Size size, const std::string& reason) {
   cv::Mat picture(size, CV_8UC3, cv::Scalar(64, 64, 64));
