@@ -106,6 +106,7 @@ TEST(RealScoreTest, PaMpjpeAndFingerStatesCompareTheShapeOnly) {
   const RealScore score = ScoreReal(labels, ReadRealPredictions(dir / "predictions.jsonl", labels));
   EXPECT_NEAR(*score.hands[0].pa_mpjpe_mm, 0.0, 1e-6);
   EXPECT_EQ(*score.hands[0].finger_agree, 4);
+  EXPECT_EQ(ToJson(score)["per_hand"][0]["pa_ref"], "keypoints_3d_camera_m");
   EXPECT_EQ(score.gt_all.finger_total, 4);
   EXPECT_FALSE(score.hands[0].handedness_ok.has_value()) << "no side predicted";
 }

@@ -1,5 +1,6 @@
 #include "nphand/eval/real_eval.h"
 
+#include <algorithm>
 #include <map>
 #include <set>
 

@@ -456,7 +456,6 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
   score.gt_one_hand = aggregate([&](const RealHandScore& r) { return gt(r) && r.hands_in_image == 1; }, true);
   score.gt_two_hand = aggregate([&](const RealHandScore& r) { return gt(r) && r.hands_in_image >= 2; }, true);
   std::vector<double> stills, video;
-  std::set<std::pair<std::string, int>> labelled_keys(order.begin(), order.end());
   for (const RealPrediction& p : predictions) {
     if (p.ms.has_value()) (p.frame.has_value() ? video : stills).push_back(*p.ms);
   }
@@ -489,6 +488,7 @@ nlohmann::json ToJson(const RealScore& score) {
       }
       if (r.pa_mpjpe_mm.has_value()) {
         h["pa_mpjpe_mm"] = *r.pa_mpjpe_mm;
+        h["pa_ref"] = r.label->world_3d ? "keypoints_3d_world_m (MediaPipe output)" : "keypoints_3d_camera_m";
         h["finger_agree"] = *r.finger_agree;
       }
     }
