@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <opencv2/imgproc.hpp>
 
+#include "nphand/eval/json_lines.h"
 #include "nphand/eval/measures.h"
 #include "nphand/model/hand_model.h"
 #include "nphand/model/hand_pose.h"
@@ -27,21 +28,8 @@ constexpr std::array<const char*, 6> kMeasures = {"joint_deg",   "wrist_deg", "k
                                                    "keypoint_px", "camera_mm", "pa_mpjpe_mm"};
 
 std::vector<nlohmann::json> ReadLines(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  NPHAND_THROW_CHECK(in.good(), path.string(), ": cannot read");
   std::vector<nlohmann::json> lines;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (line.empty()) continue;
-    try {
-      lines.push_back(nlohmann::json::parse(line));
-    } catch (const nlohmann::json::exception& e) {
-      NPHAND_THROW(path.string(), ":", number, ": not a JSON object (", e.what(), ")");
-    }
-    NPHAND_THROW_CHECK(lines.back().is_object(), path.string(), ":", number, ": not a JSON object");
-  }
+  for (JsonLine& line : ReadJsonLines(path)) lines.push_back(std::move(line.json));
   NPHAND_THROW_CHECK(!lines.empty(), path.string(), ": no lines");
   return lines;
 }
@@ -175,9 +163,6 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
 
 namespace {
 
-// A figure, or null when there was nothing to measure.
-nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
 // A figure with two decimals, or "n/a".
 std::string Figure(double v) { return std::isfinite(v) ? cv::format("%.2f", v) : std::string("n/a"); }
 
@@ -186,8 +171,8 @@ std::string Figure(double v) { return std::isfinite(v) ? cv::format("%.2f", v) :
 nlohmann::json ToJson(const PoseErrorSummary& summary) {
   nlohmann::json mean = nlohmann::json::object(), median = nlohmann::json::object();
   for (size_t m = 0; m < kMeasures.size(); ++m) {
-    mean[kMeasures[m]] = Number(summary.mean[m]);
-    median[kMeasures[m]] = Number(summary.median[m]);
+    mean[kMeasures[m]] = JsonNumber(summary.mean[m]);
+    median[kMeasures[m]] = JsonNumber(summary.median[m]);
   }
   nlohmann::json frames = nlohmann::json::array();
   for (const FramePoseError& e : summary.frames) {
@@ -206,10 +191,10 @@ nlohmann::json ToJson(const PoseErrorSummary& summary) {
           {"detected", summary.detected},
           {"mean", mean},
           {"median", median},
-          {"within_20mm", Number(summary.within_20mm)},
-          {"auc_0_50", Number(summary.auc_0_50)},
-          {"jitter_mm", Number(summary.jitter_mm)},
-          {"truth_jitter_mm", Number(summary.truth_jitter_mm)},
+          {"within_20mm", JsonNumber(summary.within_20mm)},
+          {"auc_0_50", JsonNumber(summary.auc_0_50)},
+          {"jitter_mm", JsonNumber(summary.jitter_mm)},
+          {"truth_jitter_mm", JsonNumber(summary.truth_jitter_mm)},
           {"per_frame", frames}};
 }
 

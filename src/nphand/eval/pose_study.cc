@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
+#include "nphand/eval/json_lines.h"
 #include "nphand/eval/measures.h"
 #include "nphand/eval/plot.h"
 #include "nphand/features/crop.h"
@@ -300,8 +301,6 @@ MethodScore Summarise(const std::string& method, const std::string& sequence, do
   return s;
 }
 
-nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
 }  // namespace
 
 std::vector<StudySequence> TestSequences(int frames, int width, int height, uint64_t seed) {
@@ -532,19 +531,19 @@ nlohmann::json ToJson(const MethodScore& s) {
           {"detected", s.detected},
           {"no_hand_frames", s.no_hand_frames},
           {"false_detections", s.false_detections},
-          {"pose_error", Number(s.pose_error)},
-          {"keypoint_error_mm", Number(s.keypoint_mm)},
-          {"pa_mpjpe_mm", Number(s.pa_mpjpe_mm)},
-          {"within_20mm", Number(s.within_20mm)},
-          {"auc_0_50", Number(s.auc_0_50)},
-          {"keypoint_px", Number(s.keypoint_px)},
-          {"joint_deg", Number(s.joint_deg)},
-          {"wrist_deg", Number(s.wrist_deg)},
-          {"jitter_mm", Number(s.jitter_mm)},
-          {"truth_jitter_mm", Number(s.truth_jitter_mm)},
-          {"ms_median", Number(s.ms_median)},
-          {"pose_error_normalised", Number(s.pose_error_norm)},
-          {"keypoint_error_normalised", Number(s.keypoint_norm)}};
+          {"pose_error", JsonNumber(s.pose_error)},
+          {"keypoint_error_mm", JsonNumber(s.keypoint_mm)},
+          {"pa_mpjpe_mm", JsonNumber(s.pa_mpjpe_mm)},
+          {"within_20mm", JsonNumber(s.within_20mm)},
+          {"auc_0_50", JsonNumber(s.auc_0_50)},
+          {"keypoint_px", JsonNumber(s.keypoint_px)},
+          {"joint_deg", JsonNumber(s.joint_deg)},
+          {"wrist_deg", JsonNumber(s.wrist_deg)},
+          {"jitter_mm", JsonNumber(s.jitter_mm)},
+          {"truth_jitter_mm", JsonNumber(s.truth_jitter_mm)},
+          {"ms_median", JsonNumber(s.ms_median)},
+          {"pose_error_normalised", JsonNumber(s.pose_error_norm)},
+          {"keypoint_error_normalised", JsonNumber(s.keypoint_norm)}};
 }
 
 nlohmann::json DescribeSequences(const std::vector<RenderedSequence>& sequences) {

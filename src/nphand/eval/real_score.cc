@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <numeric>
 #include <set>
@@ -10,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "nphand/eval/json_lines.h"
 #include "nphand/eval/measures.h"
 #include "nphand/util/check.h"
 
@@ -23,20 +23,6 @@ constexpr double kExtendedRatio = 0.75;
 constexpr std::array<std::array<int, 4>, 4> kFingers = {{{5, 6, 7, 8}, {9, 10, 11, 12}, {13, 14, 15, 16}, {17, 18, 19, 20}}};
 
 std::string Stem(const std::string& file) { return std::filesystem::path(file).stem().string(); }
-
-// Reads lines of JSON, skipping blank ones; `parse(json, line)` per line (1-based numbers).
-template <typename Parse>
-void ForEachJsonLine(const std::filesystem::path& path, Parse parse) {
-  std::ifstream in(path);
-  NPHAND_THROW_CHECK(in.good(), path.string(), ": cannot read");
-  std::string text;
-  for (int line = 1; std::getline(in, text); ++line) {
-    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
-    NPHAND_THROW_CHECK(!json.is_discarded() && json.is_object(), path.string(), ": line ", line, " is not a JSON object");
-    parse(json, line);
-  }
-}
 
 bool IsNumber(const nlohmann::json& j) { return j.is_number() && std::isfinite(j.get<double>()); }
 
@@ -262,7 +248,7 @@ bool IsGroundTruthSource(const std::string& source) {
 
 std::vector<RealLabel> ReadRealLabels(const std::filesystem::path& path) {
   std::vector<RealLabel> labels;
-  ForEachJsonLine(path, [&](const nlohmann::json& j, int line) {
+  for (const auto& [line, j] : ReadJsonLines(path)) {
     const std::string where = path.string() + ": line " + std::to_string(line);
     RealLabel label;
     label.line = line - 1;
@@ -307,7 +293,7 @@ std::vector<RealLabel> ReadRealLabels(const std::filesystem::path& path) {
     const double w = label.box[2] - label.box[0], h = label.box[3] - label.box[1];
     label.region = {label.box[0] - kGrow * w, label.box[1] - kGrow * h, label.box[2] + kGrow * w, label.box[3] + kGrow * h};
     labels.push_back(std::move(label));
-  });
+  }
   NPHAND_THROW_CHECK(!labels.empty(), path.string(), ": no labels");
   return labels;
 }
@@ -338,7 +324,7 @@ std::vector<RealPrediction> ReadRealPredictions(const std::filesystem::path& pat
   }
   std::vector<RealPrediction> predictions;
   std::set<std::pair<std::string, int>> seen;
-  ForEachJsonLine(path, [&](const nlohmann::json& j, int line) {
+  for (const auto& [line, j] : ReadJsonLines(path)) {
     const std::string where = path.string() + ": line " + std::to_string(line);
     RealPrediction p;
     NPHAND_THROW_CHECK(j.contains("file") && j["file"].is_string(), where, ": no 'file'");
@@ -371,7 +357,7 @@ std::vector<RealPrediction> ReadRealPredictions(const std::filesystem::path& pat
     }
     if (j.contains("ms") && IsNumber(j["ms"])) p.ms = j["ms"].get<double>();
     predictions.push_back(std::move(p));
-  });
+  }
   return predictions;
 }
 
