@@ -1,26 +1,9 @@
 #include "apps/video_file.h"
 
-#include <algorithm>
-
-#include <opencv2/imgproc.hpp>
-
+#include "nphand/render/draw.h"
 #include "nphand/util/check.h"
 
 namespace nphand {
-namespace {
-
-// `picture` scaled to fit `size` with its aspect kept, on a dark border.
-cv::Mat FitInto(const cv::Mat& picture, cv::Size size) {
-  if (picture.size() == size) return picture;
-  const double scale = std::min(static_cast<double>(size.width) / picture.cols, static_cast<double>(size.height) / picture.rows);
-  const cv::Size fitted(std::max(1, static_cast<int>(picture.cols * scale)), std::max(1, static_cast<int>(picture.rows * scale)));
-  cv::Mat out(size, CV_8UC3, cv::Scalar(32, 32, 32));
-  cv::resize(picture, out(cv::Rect((size.width - fitted.width) / 2, (size.height - fitted.height) / 2, fitted.width, fitted.height)),
-             fitted, 0, 0, cv::INTER_AREA);
-  return out;
-}
-
-}  // namespace
 
 VideoFile::VideoFile(const std::filesystem::path& path, double fps)
     : path_(path), partial_(path.string() + ".partial.mp4"), lock_(File::OpenLocked(partial_)), fps_(fps) {
@@ -44,7 +27,7 @@ void VideoFile::Write(const cv::Mat& picture) {
     video_.open(partial_.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps_, size_);
     NPHAND_THROW_CHECK(video_.isOpened(), partial_.string(), ": cannot open a video writer (MPEG-4)");
   }
-  video_.write(FitInto(picture, size_));
+  video_.write(FitInto(picture, size_, cv::Scalar(32, 32, 32)));
   ++frames_;
 }
 

@@ -142,12 +142,9 @@ cv::Mat RealContactSheet(const std::vector<RealLabel>& labels, const std::vector
   cv::Mat sheet(std::max(1, rows) * (kTile + kCaption), kColumns * kTile, CV_8UC3, cv::Scalar(24, 24, 24));
   for (size_t i = 0; i < stills.size(); ++i) {
     const std::string& file = stills[i];
-    const cv::Mat image = ReadStill(root / file);
-    const double scale = std::min(static_cast<double>(kTile) / image.cols, static_cast<double>(kTile) / image.rows);
-    const cv::Size size(std::max(1, static_cast<int>(image.cols * scale)), std::max(1, static_cast<int>(image.rows * scale)));
-    cv::Mat tile(kTile, kTile, CV_8UC3, cv::Scalar(24, 24, 24));
-    const cv::Point offset((kTile - size.width) / 2, (kTile - size.height) / 2);
-    cv::resize(image, tile(cv::Rect(offset, size)), size, 0, 0, cv::INTER_AREA);
+    double scale = 1.0;
+    cv::Point offset;
+    cv::Mat tile = FitInto(ReadStill(root / file), cv::Size(kTile, kTile), cv::Scalar(24, 24, 24), &scale, &offset);
     const auto place = [&](const Eigen::Vector2d& p) { return Eigen::Vector2d(p.x() * scale + offset.x, p.y() * scale + offset.y); };
     int found = 0, hands = 0;
     for (const RealHandScore& r : score.hands) {

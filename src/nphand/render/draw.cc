@@ -31,6 +31,18 @@ void DrawKeypoints2d(const std::array<Eigen::Vector2d, kNumKeypoints>& keypoints
   }
 }
 
+cv::Mat FitInto(const cv::Mat& image, cv::Size size, cv::Scalar border, double* scale, cv::Point* offset) {
+  const double s = std::min(static_cast<double>(size.width) / image.cols, static_cast<double>(size.height) / image.rows);
+  const cv::Size fitted(std::max(1, static_cast<int>(image.cols * s)), std::max(1, static_cast<int>(image.rows * s)));
+  const cv::Point corner((size.width - fitted.width) / 2, (size.height - fitted.height) / 2);
+  if (scale != nullptr) *scale = s;
+  if (offset != nullptr) *offset = corner;
+  if (image.size() == size) return image;
+  cv::Mat out(size, CV_8UC3, border);
+  cv::resize(image, out(cv::Rect(corner, fitted)), fitted, 0, 0, cv::INTER_AREA);
+  return out;
+}
+
 cv::Mat LabelsForDisplay(const cv::Mat& labels) {
   cv::Mat lut(1, 256, CV_8UC1, cv::Scalar(128));
   lut.at<uchar>(0) = 0;

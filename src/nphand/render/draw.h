@@ -16,6 +16,11 @@ void DrawKeypoints(const Intrinsics& intrinsics, const Keypoints3d& keypoints_in
 // The same from keypoints already in pixels (pixel centres at +0.5).
 void DrawKeypoints2d(const std::array<Eigen::Vector2d, kNumKeypoints>& keypoints, cv::Mat* bgr);
 
+// `image` (8-bit BGR) scaled to fit `size` with its aspect kept, centred on a `border`
+// background: one frame size for a video, one tile of a contact sheet. `scale` and `offset`
+// (if not null) receive the map from image pixels to the result's: p * scale + offset.
+cv::Mat FitInto(const cv::Mat& image, cv::Size size, cv::Scalar border, double* scale = nullptr, cv::Point* offset = nullptr);
+
 // A label image (PixelLabel values) as a grey picture: background black, hand white, object grey.
 cv::Mat LabelsForDisplay(const cv::Mat& labels);
 
