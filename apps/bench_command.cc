@@ -9,6 +9,7 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include "apps/index_command.h"
 #include "nphand/estimate/estimator.h"
 #include "nphand/index/backends.h"
 #include "nphand/render/renderer.h"
@@ -70,7 +71,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
     int threads;
     ~Restore() { cv::setNumThreads(threads); }
   } restore{opencv_threads};
-  const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+  const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
   const Database db = Database::Open(options.db);
   const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);

@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "apps/frame_source.h"
+#include "apps/index_command.h"
 #include "apps/video_file.h"
 #include "nphand/estimate/frame_json.h"
 #include "nphand/index/backends.h"
@@ -99,7 +100,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   NPHAND_THROW_CHECK(estimator_options.Check(&why), "estimate: ", why);
   CheckOutputFile(options.out, "--out");
   if (!options.overlay.empty()) CheckOutputFile(options.overlay, "--overlay");
-  const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+  const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
   std::error_code error;
   NPHAND_THROW_CHECK(std::filesystem::exists(options.db, error), options.db.string(),
                      ": no database there (make one with `nphand db build`)");

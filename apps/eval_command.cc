@@ -3,6 +3,7 @@
 #include <chrono>
 #include <iostream>
 
+#include "apps/index_command.h"
 #include "nphand/eval/real_eval.h"
 #include "nphand/render/draw.h"
 #include "nphand/util/check.h"
@@ -79,7 +80,7 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
     CheckFileName(options.name, "eval estimator --name");
     CheckOutputFolder(options.out_dir, "eval estimator --out");
   }
-  const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+  const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
   if (!options.out_dir.empty()) {
     CheckOutputsApart({{options.db, "--db"}, {index_path, "--index"}}, NamedOutputs(options.out_dir, options.name, {".json"}));
   }
@@ -103,7 +104,7 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
 
 EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* progress) {
   NPHAND_THROW_CHECK(!options.labels.empty(), "eval real: --labels is required (e.g. ../shared/real-dev/labels.jsonl)");
-  const std::filesystem::path index_path = options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+  const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
   if (!options.out_dir.empty()) {
     CheckOutputFolder(options.out_dir, "eval real --out");
     CheckOutputsApart({{options.labels, "--labels"}, {options.db, "--db"}, {index_path, "--index"}},
@@ -146,7 +147,7 @@ void WritePoseStudy(const PoseStudyResult& result, const std::filesystem::path& 
 }
 
 std::filesystem::path IndexPath(const EvalPoseStudyCommandOptions& options) {
-  return options.index.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.index;
+  return IndexPathOf(options.db, options.index);
 }
 
 // What a pose study reads, opened in place (the index refers to the database).

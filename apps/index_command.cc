@@ -8,10 +8,14 @@
 
 namespace nphand {
 
+std::filesystem::path IndexPathOf(const std::filesystem::path& db, const std::filesystem::path& index) {
+  return index.empty() ? std::filesystem::path(db.string() + ".idx") : index;
+}
+
 nlohmann::json RunIndexBuild(const IndexBuildCommandOptions& options) {
   std::string why;
   NPHAND_THROW_CHECK(options.index.Check(&why), "index build: ", why);
-  const std::filesystem::path out = options.out.empty() ? std::filesystem::path(options.db.string() + ".idx") : options.out;
+  const std::filesystem::path out = IndexPathOf(options.db, options.out);
   CheckOutputFile(out, "index build --out");
   CheckOutputsApart({{options.db, "--db"}}, {{out, "index build --out"}});
   const auto start = std::chrono::steady_clock::now();

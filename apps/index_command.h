@@ -16,6 +16,10 @@ struct IndexBuildCommandOptions {
   bool reuse = false;  // keep an existing `out` that loads for this database with the same backend
 };
 
+// Where a command finds (or index build writes) a database's index: `index` when given,
+// else the database's path with ".idx" appended.
+std::filesystem::path IndexPathOf(const std::filesystem::path& db, const std::filesystem::path& index);
+
 // Builds the index and writes it; returns its description, the path and the seconds it took.
 nlohmann::json RunIndexBuild(const IndexBuildCommandOptions& options);
 // The meta of an index file (backend, parameters, descriptor, the database's checksum).

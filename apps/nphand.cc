@@ -29,6 +29,9 @@ std::string Dump(const nlohmann::json& json, int indent = -1) {
   return json.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
+// A report on stdout: one line with --json, indented otherwise.
+void PrintJson(const nlohmann::json& report, bool json) { std::cout << (json ? Dump(report) : Dump(report, 2)) << "\n"; }
+
 // "a, b, c": for the lists of names in help texts.
 std::string CommaList(const std::vector<std::string>& names) {
   std::string list;
@@ -201,8 +204,7 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   pipeline->add_option("--asset-dir", p.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   pipeline->add_flag("--json", json, "Print one JSON object");
   pipeline->callback([&p, &json]() {
-    const nlohmann::json report = nphand::RunBenchPipeline(p);
-    std::cout << (json ? Dump(report) : Dump(report, 2)) << "\n";
+    PrintJson(nphand::RunBenchPipeline(p), json);
   });
   CLI::App* render = bench->add_subcommand("render", "Label images per second (hand + object, one core)");
   render->add_option("--images", o.images, "Images to time")->capture_default_str();
@@ -211,16 +213,9 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   render->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   render->add_flag("--json", json, "Print one JSON object");
   render->callback([&o, &json]() {
-    const nlohmann::json report = nphand::RunBenchRender(o);
-    if (json) {
-      std::cout << Dump(report) << "\n";
-    } else {
-      std::cout << Dump(report, 2) << "\n";
-    }
+    PrintJson(nphand::RunBenchRender(o), json);
   });
 }
-
-void PrintJson(const nlohmann::json& report, bool json) { std::cout << (json ? Dump(report) : Dump(report, 2)) << "\n"; }
 
 struct DbArgs {
   nphand::DbBuildCommandOptions build;
@@ -451,7 +446,7 @@ void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOption
       ->callback([&o, print]() { print(nphand::RunEvalPoseStudy(Part::kRobustness, o)); });
   add("all", "The whole study: features, ann, baselines, noise, robustness (needs --out)")->callback([&o, &json]() {
     const nlohmann::json summary = nphand::RunEvalAll(o);
-    std::cout << (json ? Dump(summary) : Dump(summary, 2)) << "\n";
+    PrintJson(summary, json);
   });
 }
 
