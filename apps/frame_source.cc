@@ -39,7 +39,14 @@ void ReadImage(const std::filesystem::path& path, Frame* frame) {
     frame->error = "the file is empty";
     return;
   }
-  frame->bgr = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  try {
+    frame->bgr = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  } catch (const cv::Exception& e) {
+    // Some decoders throw instead of returning nothing, e.g. for a header promising more
+    // pixels than OpenCV accepts.
+    frame->error = "cannot decode this image: " + Utf8OrEscaped(e.err);
+    return;
+  }
   if (frame->bgr.empty()) {
     frame->error = "cannot decode this image (truncated, damaged or not an image)";
     return;
@@ -105,7 +112,13 @@ std::optional<Frame> FrameSource::Next() {
       return frame;
     }
   } else {
-    if (!capture_.read(frame.bgr) || frame.bgr.empty()) {
+    bool read = false;
+    try {
+      read = capture_.read(frame.bgr);
+    } catch (const cv::Exception& e) {
+      NPHAND_THROW(input_, ": frame ", next_, " cannot be decoded: ", Utf8OrEscaped(e.err));
+    }
+    if (!read || frame.bgr.empty()) {
       // A video that gives not even its first frame is not a video.
       NPHAND_THROW_CHECK(next_ > 0, input_, ": no frame could be read from this ", kind_);
       return std::nullopt;

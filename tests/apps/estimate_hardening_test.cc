@@ -354,16 +354,24 @@ TEST_F(EstimateHardeningTest, ImagesThatCannotBeReadAreLinesAndTheRunGoesOn) {
   cv::resize(frame, larger, cv::Size(320, 200));
   cv::imwrite((input / "4_larger.png").string(), larger);
   WriteFileAtomic(input / "5_empty.png", std::string());
+  // A BMP header promising 60000 x 60000 pixels: OpenCV's decoder throws rather than return
+  // an empty image (the fuzzer found it).
+  std::string huge = std::string("BM") + std::string(12, '\0');
+  huge[10] = 54;
+  const uint32_t dib[] = {40, 60000, 60000, 1 | (24u << 16), 0, 0, 0, 0, 0, 0};
+  huge.append(reinterpret_cast<const char*>(dib), sizeof(dib));
+  huge.append(64, '\0');
+  WriteFileAtomic(input / "6_huge.bmp", huge);
   EstimateCommandOptions options = Options(dir / "poses.jsonl");
   options.input = input.string();
   options.overlay = dir / "overlay.mp4";
   const nlohmann::json summary = RunEstimate(options, nullptr, nullptr);
-  EXPECT_EQ(summary["frames"], 6);
-  EXPECT_EQ(summary["unreadable"], 2);
+  EXPECT_EQ(summary["frames"], 7);
+  EXPECT_EQ(summary["unreadable"], 3);
   EXPECT_EQ(summary["damaged"], 1);
   EXPECT_NE(summary["input"].get<std::string>().find("frames \\xE9t\\xE9"), std::string::npos) << summary["input"];
   const std::vector<nlohmann::json> lines = Lines(options.out);
-  ASSERT_EQ(lines.size(), 6u);
+  ASSERT_EQ(lines.size(), 7u);
   for (size_t i = 0; i < lines.size(); ++i) EXPECT_EQ(lines[i]["frame"], i);
   EXPECT_EQ(lines[1]["status"], "unreadable");
   EXPECT_FALSE(lines[1]["detected"].get<bool>());
@@ -374,8 +382,10 @@ TEST_F(EstimateHardeningTest, ImagesThatCannotBeReadAreLinesAndTheRunGoesOn) {
   ASSERT_TRUE(lines[2].contains("warnings")) << lines[2];
   EXPECT_NE(lines[2]["warnings"][0].get<std::string>().find("truncated JPEG"), std::string::npos);
   EXPECT_EQ(lines[3]["image"], "3_caf\\xE9.png");
+  EXPECT_EQ(lines[6]["status"], "unreadable");
+  EXPECT_NE(lines[6]["reason"].get<std::string>().find("cannot decode"), std::string::npos) << lines[6];
   EXPECT_EQ(lines[4]["status"], lines[0]["status"]);
-  EXPECT_EQ(VideoFrames(options.overlay), 6) << "one overlay frame a line, whatever the image's size";
+  EXPECT_EQ(VideoFrames(options.overlay), 7) << "one overlay frame a line, whatever the image's size";
 }
 
 TEST_F(EstimateHardeningTest, AnOverlayNotNamedMp4IsRefused) {
