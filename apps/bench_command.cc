@@ -77,6 +77,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
   EstimatorOptions estimator_options;
   estimator_options.k = options.k;
+  SetHandChoice(options.hand, &estimator_options);
   Estimator estimator(db, *index, hand, estimator_options);
   const double rss_loaded = PeakRssMb();
 
@@ -122,6 +123,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
       {"backend", index->Backend()},
       {"index_mb", index->MemoryBytes() / 1e6},
       {"k", options.k},
+      {"hand", options.hand},
       {"peak_rss_mb", PeakRssMb()},
       {"rss_after_load_mb", rss_loaded},
       {"threads", options.threads},

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -35,6 +36,7 @@ struct BenchPipelineOptions {
   int width = 640;
   int height = 480;
   int k = 500;
+  std::string hand = "right";   // right, left or auto
   uint64_t seed = 1;
   // OpenCV's threads for the image work (colour, resizing, morphology, the face cascade);
   // 1 keeps the whole path on one core, as the speed goal asks.

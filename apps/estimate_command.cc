@@ -92,7 +92,7 @@ const char* SignalName(int signal) {
 
 nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* progress, const std::atomic<int>* stop) {
   EstimatorOptions estimator_options = options.estimator;
-  estimator_options.hand = HandednessFromString(options.hand);
+  SetHandChoice(options.hand, &estimator_options);
   estimator_options.observation = ObservationWeightFromString(options.observation);
   estimator_options.prior = PriorCombinationFromString(options.prior);
   if (!options.faces) estimator_options.skin.face_cascade.clear();

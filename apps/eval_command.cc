@@ -104,6 +104,7 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
 
 EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* progress) {
   NPHAND_THROW_CHECK(!options.labels.empty(), "eval real: --labels is required (e.g. ../shared/real-dev/labels.jsonl)");
+  NPHAND_THROW_CHECK(options.hand == "given" || options.hand == "auto", "eval real: --hand is given or auto, not '", options.hand, "'");
   const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
   if (!options.out_dir.empty()) {
     CheckOutputFolder(options.out_dir, "eval real --out");
@@ -118,16 +119,18 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
   EstimatorOptions estimator_options;
   if (!options.faces) estimator_options.skin.face_cascade.clear();
+  const bool given = options.hand == "given";
+  SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, *index, hand, estimator_options);
   estimator_options.hand = Handedness::kLeft;
   Estimator left(db, *index, hand, estimator_options);
-  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, &left, progress);
+  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, given ? &left : nullptr, progress);
   const RealScore score = ScoreReal(labels, predictions);
   EvalRealResult result{ToJson(score), FormatTable(score)};
   result.figures["labels"] = options.labels.string();
   result.figures["database"] = options.db.filename().string();
   result.figures["index"] = index->Backend();
-  result.figures["hand"] = "given";
+  result.figures["hand"] = options.hand;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {
     std::string lines;

@@ -77,6 +77,7 @@ struct EvalRealCommandOptions {
   std::filesystem::path asset_dir = DefaultAssetDir();
   std::filesystem::path out_dir;  // if set: real.json, real_predictions.jsonl, real_contact.png there
   bool faces = true;              // set faces aside (OpenCV's cascade)
+  std::string hand = "given";     // "given": the labelled side; "auto": the estimator chooses
 };
 
 struct EvalRealResult {

@@ -149,7 +149,9 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--input", o.input, "Video file, image folder (name order) or camera index")->required();
   cmd->add_option("--out", o.out, "JSON lines, one object per frame (docs/FORMAT.md)")->capture_default_str();
   cmd->add_option("--overlay", o.overlay, "Overlay video (.mp4): the skeleton, and the matched database view beside it");
-  cmd->add_option("--hand", o.hand, "right or left (a left hand is mirrored into the right-hand database)")->capture_default_str();
+  cmd->add_option("--hand", o.hand,
+                  "right, left (mirrored into the right-hand database) or auto (both searched; the better side kept for the track)")
+      ->capture_default_str();
   cmd->add_option("--k", e.k, "Neighbours searched per frame")->capture_default_str();
   cmd->add_option("--observation", o.observation, "Observation weight: fixed (the paper) or adaptive (the released code)")
       ->capture_default_str();
@@ -199,6 +201,7 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   pipeline->add_option("--width", p.width, "Frame width")->capture_default_str();
   pipeline->add_option("--height", p.height, "Frame height")->capture_default_str();
   pipeline->add_option("--k", p.k, "Neighbours per frame")->capture_default_str();
+  pipeline->add_option("--hand", p.hand, "right, left or auto (both sides searched)")->capture_default_str();
   pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->check(WholeNumber())->capture_default_str();
   pipeline->add_option("--threads", p.threads, "OpenCV threads for the image work (1: one core)")->capture_default_str();
   pipeline->add_option("--asset-dir", p.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
@@ -393,6 +396,8 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   cmd->add_option("--out", o.out_dir, "Folder for real.json, real_predictions.jsonl and real_contact.png");
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
+  cmd->add_option("--hand", o.hand, "given (each labelled side searched for) or auto (the estimator chooses, and is scored)")
+      ->capture_default_str();
   cmd->add_flag("--json", json, "Print JSON instead of the table");
   cmd->callback([&o, &json]() {
     const nphand::EvalRealResult result = nphand::RunEvalReal(o, &std::cerr);

@@ -90,6 +90,19 @@ TEST_F(EstimateCommandTest, AFolderGivesOneLinePerFrameWithEveryFieldAndAnOverla
     EXPECT_EQ(line["pose_vector"].size(), 30u);
   }
   EXPECT_GE(detected, 4);
+  // --hand auto says per line which side it chose and how surely.
+  options.hand = "auto";
+  options.overlay.clear();
+  RunEstimate(options, nullptr, nullptr);
+  for (const nlohmann::json& line : Lines(options.out)) {
+    if (!line["detected"].get<bool>()) continue;
+    EXPECT_TRUE(line["hand"] == "right" || line["hand"] == "left") << line["hand"];
+    EXPECT_GE(line["hand_margin"].get<double>(), 0.0);
+  }
+  options.hand = "ambidextrous";
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "choose right, left or auto");
+  options.hand = "right";
+  RunEstimate(options, nullptr, nullptr);
   // And the errors against the truth.
   EvalPosesCommandOptions eval;
   eval.truth = *dir_ / "sequence" / "truth.jsonl";
@@ -200,6 +213,17 @@ TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles
     EXPECT_TRUE(std::filesystem::exists(options.out_dir / file)) << file;
   }
   EXPECT_EQ(Lines(options.out_dir / "real_predictions.jsonl").size(), 8u) << "a line per labelled image and frame";
+  // --hand auto: one search a still, its chosen side scored against the labels'.
+  EvalRealCommandOptions chosen = options;
+  chosen.hand = "auto";
+  chosen.out_dir.clear();
+  const EvalRealResult auto_side = RunEvalReal(chosen, nullptr);
+  EXPECT_EQ(auto_side.figures["hand"], "auto");
+  const nlohmann::json& video = auto_side.figures["per_source"]["asl_video"];
+  EXPECT_EQ(video["handedness_n"], video["found"]);
+  EXPECT_GT(video["handedness_n"], 0);
+  chosen.hand = "both";
+  testing::ExpectError([&] { RunEvalReal(chosen, nullptr); }, "--hand is given or auto");
   // A label naming a missing image is refused by name before any work; so is an output
   // folder that holds the labels.
   {

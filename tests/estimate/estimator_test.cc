@@ -189,6 +189,48 @@ TEST_F(EstimatorTest, ALeftHandIsTheMirroredRightHand) {
   }
 }
 
+// --hand auto: a hand holding an object is matched by its own side's views far better than
+// by the other's (from behind, the object would hide other parts of it), so the mirrored
+// render is a left hand. A track keeps its side through a stray frame, and changes it when
+// the other side keeps winning.
+TEST_F(EstimatorTest, AutoHandFindsTheSideAndHoldsItForATrack) {
+  size_t e = 300;  // seen from the side, where the object hides the fingers
+  while (!db_->Meta(e).with_object || !db_->Meta(e).has_hand || db_->Meta(e).viewpoint != 20) ++e;
+  EstimatorOptions options = Options();
+  options.hand_auto = true;
+  Estimator estimator(*db_, *index_, RightHand(), options);
+  const RenderedImages images = estimator.RenderEntry(static_cast<uint32_t>(e));
+  const cv::Mat right = images.labels == static_cast<int>(PixelLabel::kHand);
+  cv::Mat left;
+  cv::flip(right, left, 1);
+  const FrameResult r = estimator.ProcessMask(right, 0.0);
+  ASSERT_TRUE(r.detected()) << r.reason;
+  EXPECT_EQ(r.hand, Handedness::kRight);
+  EXPECT_EQ(r.pose.handedness, Handedness::kRight);
+  EXPECT_NEAR(r.nearest_distance, 0.0, 1e-3);
+  ASSERT_TRUE(r.hand_margin.has_value());
+  EXPECT_GT(*r.hand_margin, options.hand_switch);
+  estimator.Reset();
+  const FrameResult l = estimator.ProcessMask(left, 0.0);
+  ASSERT_TRUE(l.detected()) << l.reason;
+  EXPECT_EQ(l.hand, Handedness::kLeft);
+  EXPECT_EQ(l.pose.handedness, Handedness::kLeft);
+  EXPECT_NEAR(l.nearest_distance, 0.0, 1e-3);
+  EXPECT_NEAR(l.keypoints_2d[0].x(), right.cols - r.keypoints_2d[0].x(), 0.6);
+
+  estimator.Reset();
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(estimator.ProcessMask(right, i / 30.0).hand, Handedness::kRight);
+  const FrameResult stray = estimator.ProcessMask(left, 5 / 30.0);
+  EXPECT_EQ(stray.hand, Handedness::kRight) << "one frame does not turn a track's side";
+  EXPECT_LT(*stray.hand_margin, *r.hand_margin * 5);
+  int frames = 0;
+  while (estimator.ProcessMask(left, (6 + frames) / 30.0).hand == Handedness::kRight && frames < 10) ++frames;
+  EXPECT_LT(frames, 10) << "the other side, winning frame after frame, takes the track";
+  // Given sides are not weighed.
+  Estimator given(*db_, *index_, RightHand(), Options());
+  EXPECT_FALSE(given.ProcessMask(right, 0.0).hand_margin.has_value());
+}
+
 TEST(CombineWithPriorTest, WeightsAreNormalisedAndTwoModesSurviveUntilTheObservationSeparatesThem) {
   PoseX a = PoseX::Zero(), b = PoseX::Zero();
   b[9] = 2.0;  // far apart in pose space

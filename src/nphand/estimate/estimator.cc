@@ -152,6 +152,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the hand length must be within [0.05, 0.4] metres";
   } else if (!(max_elongation >= 1.0)) {
     *why = "the largest elongation must be at least 1 (a disk)";
+  } else if (!(hand_memory >= 0.0 && hand_memory < 1.0) || !(hand_switch >= 0.0 && hand_switch < 10.0)) {
+    *why = "the side's memory must be within [0, 1) and its switching margin within [0, 10)";
   } else if (learn_interval < 1) {
     *why = "the learning interval must be at least 1 frame";
   } else if (!skin.Check(why) || !forearm.Check(why)) {
@@ -162,6 +164,16 @@ bool EstimatorOptions::Check(std::string* why) const {
   return false;
 }
 
+void SetHandChoice(const std::string& text, EstimatorOptions* options) {
+  options->hand_auto = text == "auto";
+  if (options->hand_auto) {
+    options->hand = Handedness::kRight;
+    return;
+  }
+  NPHAND_THROW_CHECK(text == "right" || text == "left", "unknown hand '", text, "' (choose right, left or auto)");
+  options->hand = HandednessFromString(text);
+}
+
 double ModelHandLength(const Database& db) {
   for (size_t i = 0; i < db.size(); ++i) {
     if (db.Meta(i).has_hand) return HandLength(db.Keypoints(i));
@@ -170,7 +182,7 @@ double ModelHandLength(const Database& db) {
 }
 
 Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel& hand, const EstimatorOptions& options)
-    : db_(db), index_(index), hand_(hand), options_(options), segmenter_(options.skin), renderer_(hand) {
+    : db_(db), index_(index), hand_(hand), options_(options), segmenter_(options.skin), renderer_(hand), side_(options.hand) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "estimator: ", why);
   NPHAND_THROW_CHECK(db.header().value("hand", "") == "right" && hand.handedness() == Handedness::kRight,
@@ -225,6 +237,9 @@ void Estimator::Reset() {
   segmenter_.Reset();
   frame_ = 0;
   since_learn_ = 0;
+  side_ = options_.hand;
+  side_evidence_ = 0.0;
+  side_seen_ = false;
 }
 
 const Intrinsics& Estimator::intrinsics_for(cv::Size frame) const {
@@ -326,19 +341,11 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
       region.copyTo(hand(box));
     }
     result.ms.segment += Ms(part, Clock::now());
-    const bool left = options_.hand == Handedness::kLeft;
-    cv::Mat query = hand;
-    cv::Rect query_box = box;
-    if (left) {
-      cv::flip(hand, query, 1);
-      query_box.x = bgr.cols - box.x - box.width;
-    }
-    FrameResult attempt = Estimate(query, query_box, bgr.size(), result);
+    FrameResult attempt = EstimateHand(hand, box, result);
     attempt.forearm_cut = cut;
     if (attempt.detected() || c + 1 == std::min<size_t>(2, candidates.size())) {
       // The hand is lost: the next frame starts from its observation alone.
       if (!attempt.detected()) carried_.clear();
-      if (left && attempt.detected()) MirrorResult(bgr.cols, &attempt);
       if (attempt.detected()) {
         last_centre_ = cv::Point2d(attempt.box.x + 0.5 * attempt.box.width, attempt.box.y + 0.5 * attempt.box.height);
         if (++since_learn_ >= options_.learn_interval && attempt.confidence >= 0.5) {
@@ -367,18 +374,54 @@ FrameResult Estimator::ProcessMask(const cv::Mat& mask, double time_s) {
     carried_.clear();
     return result;
   }
-  const bool left = options_.hand == Handedness::kLeft;
-  cv::Mat query = mask != 0;
-  cv::Rect query_box = box;
-  if (left) {
-    cv::flip(query, query, 1);
-    query_box.x = mask.cols - box.x - box.width;
-  }
-  FrameResult out = Estimate(query, query_box, mask.size(), result);
+  FrameResult out = EstimateHand(mask != 0, box, result);
   if (!out.detected()) carried_.clear();
-  if (left && out.detected()) MirrorResult(mask.cols, &out);
   out.ms.total = Ms(start, Clock::now());
   return out;
+}
+
+FrameResult Estimator::EstimateSide(const cv::Mat& hand_mask, cv::Rect box, Handedness side, FrameResult result) {
+  result.hand = side;
+  if (side == Handedness::kRight) return Estimate(hand_mask, box, hand_mask.size(), std::move(result));
+  cv::Mat mirrored;
+  cv::flip(hand_mask, mirrored, 1);
+  const cv::Rect mirrored_box(hand_mask.cols - box.x - box.width, box.y, box.width, box.height);
+  FrameResult out = Estimate(mirrored, mirrored_box, hand_mask.size(), std::move(result));
+  if (out.detected()) MirrorResult(hand_mask.cols, &out);
+  out.box = box;
+  return out;
+}
+
+FrameResult Estimator::EstimateHand(const cv::Mat& hand_mask, cv::Rect box, FrameResult result) {
+  if (!options_.hand_auto) return EstimateSide(hand_mask, box, options_.hand, std::move(result));
+  const Handedness other = side_ == Handedness::kRight ? Handedness::kLeft : Handedness::kRight;
+  FrameResult held = EstimateSide(hand_mask, box, side_, result);
+  // The other side starts without the carried hypotheses: they are poses of this side's.
+  std::vector<WeightedPose> held_carried = std::move(carried_);
+  carried_.clear();
+  FrameResult turned = EstimateSide(hand_mask, box, other, std::move(result));
+  // Both searched (a region too thin for a hand is searched for neither): the difference
+  // of their nearest distances is this frame's evidence.
+  if (held.searched && turned.searched) {
+    side_evidence_ = options_.hand_memory * side_evidence_ + (turned.nearest_distance - held.nearest_distance);
+    const bool first = !side_seen_;
+    side_seen_ = true;
+    if (side_evidence_ < (first ? 0.0 : -options_.hand_switch)) {
+      side_ = other;
+      side_evidence_ = -side_evidence_;
+      turned.hand_margin = side_evidence_;
+      turned.ms.describe += held.ms.describe;
+      turned.ms.search += held.ms.search;
+      turned.ms.weigh += held.ms.weigh;
+      return turned;
+    }
+  }
+  carried_ = std::move(held_carried);
+  held.hand_margin = side_evidence_;
+  held.ms.describe += turned.ms.describe;
+  held.ms.search += turned.ms.search;
+  held.ms.weigh += turned.ms.weigh;
+  return held;
 }
 
 FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result) {
@@ -455,6 +498,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   NPHAND_CHECK(!hyp.empty(), "the index returned no neighbours");
   double nearest = hyp[0].distance;
   for (const Candidate& h : hyp) nearest = std::min(nearest, h.distance);
+  result.searched = true;
   result.nearest_distance = nearest;
   if (nearest > options_.max_distance) {
     result.status = FrameStatus::kNotAHand;

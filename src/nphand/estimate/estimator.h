@@ -66,6 +66,14 @@ struct EstimatorOptions {
   // 99.9 % at most 4.7, 99.99 % at most 5.9, the thinnest 10.0 (`nphand db info`).
   double max_elongation = 6.0;
   Handedness hand = Handedness::kRight;         // left: mirrored into the right-hand database
+  // Either side (`--hand auto`): each region is searched as it is and mirrored, and the side
+  // whose nearest entry is nearer gains the difference of the two distances as evidence.
+  // A track's evidence decays by `hand_memory` a frame, and its side changes only when the
+  // other side leads by more than `hand_switch` (feature distance); a track's first frame
+  // takes the nearer side. `hand` is where a track starts when the two tie.
+  bool hand_auto = false;
+  double hand_memory = 0.8;
+  double hand_switch = 0.05;
   // Camera: a focal length in pixels, or (focal_px = 0) a horizontal field of view.
   double focal_px = 0.0;
   double fov_deg = 60.0;
@@ -76,6 +84,10 @@ struct EstimatorOptions {
   int learn_interval = 10;                      // frames between skin-colour updates from confident frames
   bool Check(std::string* why) const;
 };
+
+// Sets `options`' hand from "right", "left" or "auto" (hand_auto, starting right); throws
+// nphand::Error for anything else.
+void SetHandChoice(const std::string& text, EstimatorOptions* options);
 
 enum class FrameStatus : uint8_t {
   kDetected,
@@ -101,6 +113,9 @@ struct FrameResult {
   double time_s = 0.0;
   FrameStatus status = FrameStatus::kNoSkin;
   std::string reason;                          // why not detected, for people
+  Handedness hand = Handedness::kRight;        // the side searched for (chosen, with hand_auto)
+  // hand_auto: the track's evidence for `hand` over the other side (feature distance, >= 0).
+  std::optional<double> hand_margin;
   bool detected() const { return status == FrameStatus::kDetected; }
   // The estimate (valid when detected).
   HandPose pose;
@@ -115,7 +130,8 @@ struct FrameResult {
   std::vector<Hypothesis> top;                 // the best top_n, best first
   std::vector<std::pair<std::string, double>> grasps;   // posterior over grasp names, descending
   std::vector<std::pair<std::string, double>> objects;  // posterior over object shapes ("none": no object)
-  double nearest_distance = 0.0;               // the best neighbour's feature distance
+  bool searched = false;                       // the region was looked up in the database
+  double nearest_distance = 0.0;               // the best neighbour's feature distance (if searched)
   double effective_samples = 0.0;              // 1 / sum w^2 over the hypotheses
   double confidence = 0.0;                     // the posterior mass near the estimate, 0..1
   StageMilliseconds ms;
@@ -167,6 +183,12 @@ class Estimator {
   // time filled in. A region unlike any view leaves the carried hypotheses as they were
   // (the caller may try another region, and forgets them if none is a hand).
   FrameResult Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result);
+  // Estimate for a hand of side `side`: a left hand's mask is mirrored into the right-hand
+  // database, and its result mirrored back.
+  FrameResult EstimateSide(const cv::Mat& hand_mask, cv::Rect box, Handedness side, FrameResult result);
+  // The same for the side the track holds, or with hand_auto for both sides, keeping the
+  // side the evidence favours (and its carried hypotheses).
+  FrameResult EstimateHand(const cv::Mat& hand_mask, cv::Rect box, FrameResult result);
   const Grasp& GraspOf(int id) const;
   Scene EntryScene(uint32_t entry);
 
@@ -211,6 +233,9 @@ class Estimator {
   uint64_t placements_clock_ = 0;  // counts the placements asked for
   std::vector<WeightedPose> carried_;
   std::optional<cv::Point2d> last_centre_;
+  Handedness side_ = Handedness::kRight;  // the track's side
+  double side_evidence_ = 0.0;            // hand_auto: for side_ over the other (decaying sum)
+  bool side_seen_ = false;                // hand_auto: the track has weighed both sides
   int frame_ = 0;
   int since_learn_ = 0;
 };

@@ -47,7 +47,8 @@ nlohmann::json FrameResultJson(const FrameResult& r, const Database& db, bool wi
   const PoseVector pose = ToPoseVector(r.pose);
   nlohmann::json keypoints_2d = nlohmann::json::array();
   for (const Eigen::Vector2d& k : r.keypoints_2d) keypoints_2d.push_back({k.x(), k.y()});
-  j["hand"] = ToString(r.pose.handedness);
+  j["hand"] = ToString(r.hand);
+  if (r.hand_margin.has_value()) j["hand_margin"] = *r.hand_margin;
   j["wrist_rotation"] = Rotation(r.pose.camera_from_hand);
   j["wrist_quaternion_wxyz"] = {q.w(), q.x(), q.y(), q.z()};
   j["joint_angles_deg"] = Angles(r.pose.angles);

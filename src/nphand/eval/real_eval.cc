@@ -44,11 +44,11 @@ cv::Mat ReadStill(const std::filesystem::path& path) {
   return bgr;
 }
 
-PredictedHand HandOf(const FrameResult& result, Handedness side) {
+PredictedHand HandOf(const FrameResult& result) {
   PredictedHand hand;
   hand.keypoints_2d = result.keypoints_2d;
   hand.keypoints_3d = result.keypoints_hand;
-  hand.hand = side == Handedness::kRight ? "right" : "left";
+  hand.hand = ToString(result.hand);
   return hand;
 }
 
@@ -93,19 +93,21 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
     RealPrediction prediction;
     prediction.file = file;
     prediction.ms = 0.0;
-    for (const std::string& side : sides[file]) {
+    // One estimate a labelled side, or one in all when the estimator chooses the side.
+    const std::set<std::string> searched = left != nullptr ? sides[file] : std::set<std::string>{"either"};
+    for (const std::string& side : searched) {
       Estimator* estimator = side == "left" ? left : right;
       estimator->Reset();
       const FrameResult result = estimator->Process(bgr, 0.0);
       *prediction.ms += result.ms.total;
-      if (result.detected()) prediction.hands.push_back(HandOf(result, estimator->options().hand));
+      if (result.detected()) prediction.hands.push_back(HandOf(result));
     }
     predictions.push_back(std::move(prediction));
     line.Update(++done);
   }
   for (const std::string& file : videos) {
     // One side per video: the first labelled.
-    Estimator* estimator = *sides[file].begin() == "left" ? left : right;
+    Estimator* estimator = left != nullptr && *sides[file].begin() == "left" ? left : right;
     estimator->Reset();
     cv::VideoCapture video((root / file).string(), cv::CAP_FFMPEG);
     NPHAND_THROW_CHECK(video.isOpened(), (root / file).string(), ": cannot read this as a video");
@@ -121,7 +123,7 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
         prediction.file = file;
         prediction.frame = frame;
         prediction.ms = result.ms.total;
-        if (result.detected()) prediction.hands.push_back(HandOf(result, estimator->options().hand));
+        if (result.detected()) prediction.hands.push_back(HandOf(result));
         predictions.push_back(std::move(prediction));
       }
       line.Update(++done);

@@ -21,11 +21,12 @@ namespace nphand {
 // not, before any estimation.
 void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem::path& root);
 
-// The estimator's predictions for every labelled image and video frame. The hand's side is
-// the label's ("given"): each side labelled in an image is estimated once, by `right` or
-// `left` (estimators over one database, differing in their `hand`), each reset first; an
-// image without a labelled side is estimated as a right hand. `progress` (if not null)
-// gets a progress line.
+// The estimator's predictions for every labelled image and video frame. With `left`, the
+// hand's side is the label's ("given"): each side labelled in an image is estimated once,
+// by `right` or `left` (estimators over one database, differing in their `hand`), each
+// reset first; an image without a labelled side is estimated as a right hand. Without
+// `left` (null), `right` chooses the side itself (hand_auto) and each image is estimated
+// once. `progress` (if not null) gets a progress line.
 std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, const std::filesystem::path& root,
                                          Estimator* right, Estimator* left, std::ostream* progress);
 
