@@ -231,6 +231,42 @@ TEST_F(EstimatorTest, AutoHandFindsTheSideAndHoldsItForATrack) {
   EXPECT_FALSE(given.ProcessMask(right, 0.0).hand_margin.has_value());
 }
 
+// A hand whose silhouette the forearm cut takes for an arm (a region at the frame's edge
+// that widens away from it) loses part of itself to the cut; when what is left looks like
+// no database view, the whole region is judged too, and is the hand.
+TEST_F(EstimatorTest, AHandTheForearmCutWouldMaimIsJudgedWhole) {
+  EstimatorOptions options = Options();
+  options.max_distance = 0.3;
+  options.skin.adapt = false;
+  Estimator estimator(*db_, *index_, RightHand(), options);
+  int tried = 0;
+  for (size_t e = EntryWithoutObject(*db_, 0); e < db_->size() && tried < 3; e = EntryWithoutObject(*db_, e + 1)) {
+    const cv::Mat labels = estimator.RenderEntry(static_cast<uint32_t>(e)).labels;
+    // Three times the database's size, so that the skin mask's clean-up keeps the fingers.
+    cv::Mat silhouette;
+    cv::resize(labels == static_cast<int>(PixelLabel::kHand), silhouette, {}, 3.0, 3.0, cv::INTER_NEAREST);
+    const cv::Rect box = cv::boundingRect(silhouette);
+    // The hand on a grey wall, standing on the frame's bottom edge.
+    cv::Mat frame(box.height + 40, box.width + 80, CV_8UC3, cv::Scalar(128, 128, 128));
+    const cv::Rect at(40, 40, box.width, box.height);
+    frame(at).setTo(cv::Scalar(90, 130, 200), silhouette(box));
+    const ForearmCut cut = CutForearm(silhouette(box), 8);
+    if (!cut.cut) continue;
+    cv::Mat maimed = cv::Mat::zeros(frame.size(), CV_8UC1);
+    cut.hand.copyTo(maimed(at));
+    estimator.Reset();
+    if (estimator.ProcessMask(maimed, 0.0).detected()) continue;
+    ++tried;
+    estimator.Reset();
+    const FrameResult r = estimator.Process(frame, 0.0);
+    ASSERT_TRUE(r.detected()) << "entry " << e << ": " << r.reason;
+    EXPECT_FALSE(r.forearm_cut);
+    EXPECT_LT(r.nearest_distance, 0.3);
+    EXPECT_GE((r.box & at).area(), 0.9 * at.area());
+  }
+  EXPECT_EQ(tried, 3) << "hands the cut maims";
+}
+
 TEST(CombineWithPriorTest, WeightsAreNormalisedAndTwoModesSurviveUntilTheObservationSeparatesThem) {
   PoseX a = PoseX::Zero(), b = PoseX::Zero();
   b[9] = 2.0;  // far apart in pose space

@@ -328,21 +328,32 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
   // The best region that looks like a hand; a second try if the first does not.
   for (size_t c = 0; c < std::min<size_t>(2, candidates.size()); ++c) {
     const Clock::time_point part = Clock::now();
-    cv::Rect box;
-    const cv::Mat region = GatherHand(skin, *candidates[c], &box);
+    cv::Rect region_box;
+    const cv::Mat region = GatherHand(skin, *candidates[c], &region_box);
     cv::Mat hand = cv::Mat::zeros(bgr.size(), CV_8UC1);
+    cv::Rect box = region_box;
     bool cut = false;
     if (options_.cut_forearm) {
-      const ForearmCut forearm = CutForearm(region, Border(box, bgr.size()), options_.forearm);
+      const ForearmCut forearm = CutForearm(region, Border(region_box, bgr.size()), options_.forearm);
       cut = forearm.cut;
-      forearm.hand.copyTo(hand(box));
-      if (cut) box = cv::boundingRect(forearm.hand) + box.tl();
+      forearm.hand.copyTo(hand(region_box));
+      if (cut) box = cv::boundingRect(forearm.hand) + region_box.tl();
     } else {
-      region.copyTo(hand(box));
+      region.copyTo(hand(region_box));
     }
     result.ms.segment += Ms(part, Clock::now());
     FrameResult attempt = EstimateHand(hand, box, result);
     attempt.forearm_cut = cut;
+    if (cut && !attempt.detected() && attempt.searched) {
+      // The cut may have gone through the hand: the whole region is judged as well.
+      hand.setTo(0);
+      region.copyTo(hand(region_box));
+      FrameResult whole = EstimateHand(hand, region_box, result);
+      whole.ms.describe += attempt.ms.describe;
+      whole.ms.search += attempt.ms.search;
+      whole.ms.weigh += attempt.ms.weigh;
+      attempt = std::move(whole);
+    }
     if (attempt.detected() || c + 1 == std::min<size_t>(2, candidates.size())) {
       // The hand is lost: the next frame starts from its observation alone.
       if (!attempt.detected()) carried_.clear();
