@@ -249,11 +249,34 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   }
 
   const std::vector<RegionStats> stats = LabelRegions(out.skin, &out.labels);
+  // What the set-aside shapes leave of a head or neck (the edge of a wider neck, a cheek):
+  // regions lying almost wholly within a fifth of a face's width of them.
+  std::vector<int> near_face(stats.size(), 0);
+  if (!faces_.empty()) {
+    cv::Mat zone = cv::Mat::zeros(work.size(), CV_8UC1);
+    for (const cv::Rect& frame_face : faces_) {
+      const cv::Rect f = working_box(frame_face);
+      const int g = f.width / 5;
+      const cv::Point centre(f.x + f.width / 2, f.y + f.height / 2);
+      cv::ellipse(zone, centre, cv::Size(f.width * 7 / 10 + g, f.height * 9 / 10 + g), 0, 0, 360, cv::Scalar(255), cv::FILLED);
+      cv::rectangle(zone, cv::Rect(f.x + f.width / 5 - g, centre.y, f.width * 3 / 5 + 2 * g, f.height * 3 / 2 + g), cv::Scalar(255),
+                    cv::FILLED);
+    }
+    for (int y = 0; y < zone.rows; ++y) {
+      const uint8_t* in_zone = zone.ptr<uint8_t>(y);
+      const int* label = out.labels.ptr<int>(y);
+      for (int x = 0; x < zone.cols; ++x) near_face[label[x]] += in_zone[x] != 0;
+    }
+  }
   const int min_area = std::max(1, static_cast<int>(options_.min_area * work.total()));
   const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
   for (size_t label = 1; label < stats.size(); ++label) {
     const RegionStats& found = stats[label];
     if (found.area < min_area) continue;
+    if (near_face[label] >= 0.8 * found.area) {
+      out.face_pixels += found.area * scale * scale;
+      continue;
+    }
     SkinRegion region;
     region.label = static_cast<int>(label);
     region.area = found.area * scale * scale;
