@@ -240,6 +240,7 @@ void Estimator::Reset() {
   side_ = options_.hand;
   side_evidence_ = 0.0;
   side_seen_ = false;
+  side_frame_ = -1;
 }
 
 const Intrinsics& Estimator::intrinsics_for(cv::Size frame) const {
@@ -413,7 +414,9 @@ FrameResult Estimator::EstimateHand(const cv::Mat& hand_mask, cv::Rect box, Fram
   FrameResult turned = EstimateSide(hand_mask, box, other, std::move(result));
   // Both searched (a region too thin for a hand is searched for neither): the difference
   // of their nearest distances is this frame's evidence.
-  if (held.searched && turned.searched) {
+  // Once a frame: a region judged again whole is the same frame's evidence.
+  if (held.searched && turned.searched && held.frame != side_frame_) {
+    side_frame_ = held.frame;
     side_evidence_ = options_.hand_memory * side_evidence_ + (turned.nearest_distance - held.nearest_distance);
     const bool first = !side_seen_;
     side_seen_ = true;

@@ -236,6 +236,7 @@ class Estimator {
   Handedness side_ = Handedness::kRight;  // the track's side
   double side_evidence_ = 0.0;            // hand_auto: for side_ over the other (decaying sum)
   bool side_seen_ = false;                // hand_auto: the track has weighed both sides
+  int side_frame_ = -1;                   // hand_auto: the frame last weighed
   int frame_ = 0;
   int since_learn_ = 0;
 };
