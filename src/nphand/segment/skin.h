@@ -64,7 +64,7 @@ struct SkinSegmentation {
   cv::Mat labels;                   // CV_32SC1, working resolution, connected regions of `skin` (0: none)
   std::vector<SkinRegion> regions;  // at least min_area, largest first
   std::vector<cv::Rect> faces;      // the faces in view (the last look's, followed since), frame pixels
-  int face_pixels = 0;              // frame pixels of skin set aside as faces (heads and necks)
+  int face_pixels = 0;              // frame pixels of skin set aside as faces (heads, necks and what they leave of them)
   bool faces_looked = false;        // the face cascade ran on this frame
   // The pixels of the regions labelled `which` within `box` (frame pixels), at the frame's
   // resolution: CV_8UC1 of the box's size, 255 = skin.
