@@ -67,7 +67,14 @@ void MirrorResult(int width, FrameResult* r) {
     r->keypoints_hand[k].x() = -r->keypoints_hand[k].x();
     r->keypoints_camera[k].x() = -r->keypoints_camera[k].x();
   }
-  r->box.x = width - r->box.x - r->box.width;
+}
+
+// A region looked up more than once in a frame (both sides, or cut and whole): `kept`, the
+// result given, also counts the time of `other`'s lookup.
+void AddLookupTime(const FrameResult& other, FrameResult* kept) {
+  kept->ms.describe += other.ms.describe;
+  kept->ms.search += other.ms.search;
+  kept->ms.weigh += other.ms.weigh;
 }
 
 }  // namespace
@@ -239,7 +246,6 @@ void Estimator::Reset() {
   since_learn_ = 0;
   side_ = options_.hand;
   side_evidence_ = 0.0;
-  side_seen_ = false;
   side_frame_ = -1;
 }
 
@@ -350,9 +356,7 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
       hand.setTo(0);
       region.copyTo(hand(region_box));
       FrameResult whole = EstimateHand(hand, region_box, result);
-      whole.ms.describe += attempt.ms.describe;
-      whole.ms.search += attempt.ms.search;
-      whole.ms.weigh += attempt.ms.weigh;
+      AddLookupTime(attempt, &whole);
       attempt = std::move(whole);
     }
     if (attempt.detected() || c + 1 == std::min<size_t>(2, candidates.size())) {
@@ -416,25 +420,20 @@ FrameResult Estimator::EstimateHand(const cv::Mat& hand_mask, cv::Rect box, Fram
   // of their nearest distances is this frame's evidence.
   // Once a frame: a region judged again whole is the same frame's evidence.
   if (held.searched && turned.searched && held.frame != side_frame_) {
+    const bool first = side_frame_ < 0;
     side_frame_ = held.frame;
     side_evidence_ = options_.hand_memory * side_evidence_ + (turned.nearest_distance - held.nearest_distance);
-    const bool first = !side_seen_;
-    side_seen_ = true;
     if (side_evidence_ < (first ? 0.0 : -options_.hand_switch)) {
       side_ = other;
       side_evidence_ = -side_evidence_;
       turned.hand_margin = side_evidence_;
-      turned.ms.describe += held.ms.describe;
-      turned.ms.search += held.ms.search;
-      turned.ms.weigh += held.ms.weigh;
+      AddLookupTime(held, &turned);
       return turned;
     }
   }
   carried_ = std::move(held_carried);
   held.hand_margin = side_evidence_;
-  held.ms.describe += turned.ms.describe;
-  held.ms.search += turned.ms.search;
-  held.ms.weigh += turned.ms.weigh;
+  AddLookupTime(turned, &held);
   return held;
 }
 

@@ -235,8 +235,7 @@ class Estimator {
   std::optional<cv::Point2d> last_centre_;
   Handedness side_ = Handedness::kRight;  // the track's side
   double side_evidence_ = 0.0;            // hand_auto: for side_ over the other (decaying sum)
-  bool side_seen_ = false;                // hand_auto: the track has weighed both sides
-  int side_frame_ = -1;                   // hand_auto: the frame last weighed
+  int side_frame_ = -1;                   // hand_auto: the frame last weighed (-1: none yet in this track)
   int frame_ = 0;
   int since_learn_ = 0;
 };

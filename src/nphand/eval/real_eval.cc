@@ -94,9 +94,12 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
     prediction.file = file;
     prediction.ms = 0.0;
     // One estimate a labelled side, or one in all when the estimator chooses the side.
-    const std::set<std::string> searched = left != nullptr ? sides[file] : std::set<std::string>{"either"};
-    for (const std::string& side : searched) {
-      Estimator* estimator = side == "left" ? left : right;
+    std::vector<Estimator*> estimators = {right};
+    if (left != nullptr) {
+      estimators.clear();
+      for (const std::string& side : sides[file]) estimators.push_back(side == "left" ? left : right);
+    }
+    for (Estimator* estimator : estimators) {
       estimator->Reset();
       const FrameResult result = estimator->Process(bgr, 0.0);
       *prediction.ms += result.ms.total;

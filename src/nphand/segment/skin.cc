@@ -235,15 +235,25 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     }
   }
   out.faces = faces_;
-  if (!faces_.empty()) {
-    cv::Mat face_mask = cv::Mat::zeros(work.size(), CV_8UC1);
+  // Each face's head (an ellipse about its box) and neck (a rectangle below), grown by
+  // `grow` faces' widths, drawn into `mask` (working pixels); returns their bounds.
+  auto draw_faces = [&](double grow, cv::Mat* mask) {
+    cv::Rect bounds;
     for (const cv::Rect& frame_face : faces_) {
       const cv::Rect f = working_box(frame_face);
+      const int g = static_cast<int>(grow * f.width);
       const cv::Point centre(f.x + f.width / 2, f.y + f.height / 2);
-      cv::ellipse(face_mask, centre, cv::Size(f.width * 7 / 10, f.height * 9 / 10), 0, 0, 360, cv::Scalar(255), cv::FILLED);
-      cv::rectangle(face_mask, cv::Rect(f.x + f.width / 5, centre.y, f.width * 3 / 5, f.height * 3 / 2), cv::Scalar(255),
-                    cv::FILLED);
+      const cv::Size head(f.width * 7 / 10 + g, f.height * 9 / 10 + g);
+      const cv::Rect neck(f.x + f.width / 5 - g, centre.y, f.width * 3 / 5 + 2 * g, f.height * 3 / 2 + g);
+      cv::ellipse(*mask, centre, head, 0, 0, 360, cv::Scalar(255), cv::FILLED);
+      cv::rectangle(*mask, neck, cv::Scalar(255), cv::FILLED);
+      bounds |= cv::Rect(centre - cv::Point(head.width, head.height), centre + cv::Point(head.width, head.height)) | neck;
     }
+    return bounds & whole;
+  };
+  if (!faces_.empty()) {
+    cv::Mat face_mask = cv::Mat::zeros(work.size(), CV_8UC1);
+    draw_faces(0.0, &face_mask);
     out.face_pixels = cv::countNonZero(out.skin & face_mask) * scale * scale;
     out.skin.setTo(0, face_mask);
   }
@@ -254,18 +264,11 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   std::vector<int> near_face(stats.size(), 0);
   if (!faces_.empty()) {
     cv::Mat zone = cv::Mat::zeros(work.size(), CV_8UC1);
-    for (const cv::Rect& frame_face : faces_) {
-      const cv::Rect f = working_box(frame_face);
-      const int g = f.width / 5;
-      const cv::Point centre(f.x + f.width / 2, f.y + f.height / 2);
-      cv::ellipse(zone, centre, cv::Size(f.width * 7 / 10 + g, f.height * 9 / 10 + g), 0, 0, 360, cv::Scalar(255), cv::FILLED);
-      cv::rectangle(zone, cv::Rect(f.x + f.width / 5 - g, centre.y, f.width * 3 / 5 + 2 * g, f.height * 3 / 2 + g), cv::Scalar(255),
-                    cv::FILLED);
-    }
-    for (int y = 0; y < zone.rows; ++y) {
+    const cv::Rect bounds = draw_faces(0.2, &zone);
+    for (int y = bounds.y; y < bounds.y + bounds.height; ++y) {
       const uint8_t* in_zone = zone.ptr<uint8_t>(y);
       const int* label = out.labels.ptr<int>(y);
-      for (int x = 0; x < zone.cols; ++x) near_face[label[x]] += in_zone[x] != 0;
+      for (int x = bounds.x; x < bounds.x + bounds.width; ++x) near_face[label[x]] += in_zone[x] != 0;
     }
   }
   const int min_area = std::max(1, static_cast<int>(options_.min_area * work.total()));
