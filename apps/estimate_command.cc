@@ -1,7 +1,6 @@
 #include "apps/estimate_command.h"
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -111,9 +110,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   if (!options.overlay.empty()) outputs.push_back({options.overlay, "--overlay"});
   CheckOutputsApart(Inputs(options, index_path, source), outputs);
   if (!options.overlay.empty()) {
-    std::string extension = options.overlay.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
-    NPHAND_THROW_CHECK(extension == ".mp4", "--overlay '", options.overlay.string(),
+    NPHAND_THROW_CHECK(AsciiLower(options.overlay.extension().string()) == ".mp4", "--overlay '", options.overlay.string(),
                        "': nphand writes the overlay as MPEG-4; name it .mp4");
   }
 

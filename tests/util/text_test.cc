@@ -21,4 +21,10 @@ TEST(TextTest, BytesThatAreNotUtf8AreEscaped) {
 }
 
 }  // namespace
+TEST(TextTest, AsciiLowerLowersCapitalsOnly) {
+  EXPECT_EQ(AsciiLower("Clip.MP4"), "clip.mp4");
+  EXPECT_EQ(AsciiLower("RIGHT"), "right");
+  EXPECT_EQ(AsciiLower("caf\xC9.PNG"), "caf\xC9.png") << "bytes beyond ASCII are kept";
+}
+
 }  // namespace nphand

@@ -12,6 +12,7 @@
 #include "nphand/eval/json_lines.h"
 #include "nphand/eval/measures.h"
 #include "nphand/util/check.h"
+#include "nphand/util/text.h"
 
 namespace nphand {
 namespace {
@@ -53,8 +54,7 @@ Keypoints3d Points3(const nlohmann::json& j, const std::string& name, const std:
 std::string Side(const nlohmann::json& j, const std::string& where) {
   if (j.is_null()) return "";
   NPHAND_THROW_CHECK(j.is_string(), where, ": hand must be \"left\", \"right\" or null");
-  std::string side = j.get<std::string>();
-  std::transform(side.begin(), side.end(), side.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string side = AsciiLower(j.get<std::string>());
   NPHAND_THROW_CHECK(side == "left" || side == "right", where, ": hand must be \"left\", \"right\" or null, not '", side, "'");
   return side;
 }

@@ -11,4 +11,8 @@ namespace nphand {
 // that is not UTF-8 can still be named in JSON and told apart from others.
 std::string Utf8OrEscaped(std::string_view text);
 
+// `text` with its ASCII capitals in lower case (other bytes kept): file extensions and
+// keywords compared without regard to case.
+std::string AsciiLower(std::string_view text);
+
 }  // namespace nphand
