@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <iostream>
+#include <optional>
 
 #include "apps/index_command.h"
 #include "nphand/eval/real_eval.h"
@@ -122,9 +123,13 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, *index, hand, estimator_options);
-  estimator_options.hand = Handedness::kLeft;
-  Estimator left(db, *index, hand, estimator_options);
-  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, given ? &left : nullptr, progress);
+  // With the side given, a second estimator for the left hands.
+  std::optional<Estimator> left;
+  if (given) {
+    estimator_options.hand = Handedness::kLeft;
+    left.emplace(db, *index, hand, estimator_options);
+  }
+  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, left ? &*left : nullptr, progress);
   const RealScore score = ScoreReal(labels, predictions);
   EvalRealResult result{ToJson(score), FormatTable(score)};
   result.figures["labels"] = options.labels.string();
