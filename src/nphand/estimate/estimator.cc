@@ -352,8 +352,8 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
     FrameResult attempt = EstimateHand(hand, box, result);
     attempt.forearm_cut = cut;
     if (cut && !attempt.detected() && attempt.searched) {
-      // The cut may have gone through the hand: the whole region is judged as well.
-      hand.setTo(0);
+      // The cut may have gone through the hand: the whole region is judged as well (the cut
+      // hand lies within the region's box, which the region overwrites).
       region.copyTo(hand(region_box));
       FrameResult whole = EstimateHand(hand, region_box, result);
       AddLookupTime(attempt, &whole);
