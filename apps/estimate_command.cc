@@ -100,15 +100,16 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   CheckOutputFile(options.out, "--out");
   if (!options.overlay.empty()) CheckOutputFile(options.overlay, "--overlay");
   const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
+  FrameSource source(options.input, options.fps);
+  std::vector<NamedPath> outputs = {{options.out, "--out"}};
+  if (!options.overlay.empty()) outputs.push_back({options.overlay, "--overlay"});
+  // A clash first: it is the graver mistake, and names the file at stake.
+  CheckOutputsApart(Inputs(options, index_path, source), outputs);
   std::error_code error;
   NPHAND_THROW_CHECK(std::filesystem::exists(options.db, error), options.db.string(),
                      ": no database there (make one with `nphand db build`)");
   NPHAND_THROW_CHECK(std::filesystem::exists(index_path, error), index_path.string(),
                      ": no index there (make one with `nphand index build --db ", options.db.string(), "`)");
-  FrameSource source(options.input, options.fps);
-  std::vector<NamedPath> outputs = {{options.out, "--out"}};
-  if (!options.overlay.empty()) outputs.push_back({options.overlay, "--overlay"});
-  CheckOutputsApart(Inputs(options, index_path, source), outputs);
   if (!options.overlay.empty()) {
     NPHAND_THROW_CHECK(AsciiLower(options.overlay.extension().string()) == ".mp4", "--overlay '", options.overlay.string(),
                        "': nphand writes the overlay as MPEG-4; name it .mp4");

@@ -185,6 +185,10 @@ TEST_F(EstimateHardeningTest, AnOutputThatIsAnInputIsRefusedAndTheInputKept) {
   options = Options(Db());
   options.db = dir / "linked.db";
   refused(options, "is --db '" + (dir / "linked.db").string() + "'");
+  // Named as a clash even when the database's default index is missing.
+  std::filesystem::create_symlink(Db(), dir / "unindexed.db");
+  options.db = dir / "unindexed.db";
+  refused(options, "is --db '" + (dir / "unindexed.db").string() + "'");
   options = Options(dir / "poses.jsonl");
   options.overlay = Db();
   refused(options, "--overlay '" + Db().string() + "' is --db");
