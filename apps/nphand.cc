@@ -110,6 +110,7 @@ void AddSequenceCommand(CLI::App& app, nphand::SequenceCommandOptions& o) {
   cmd->add_option("--skin", s.skin, "Skin tone: light, medium, olive, brown, dark (default: by the seed)");
   cmd->add_option("--background", o.background, "plain, texture or clutter")->capture_default_str();
   cmd->add_flag("--face", s.face, "Put a face beside the hand");
+  cmd->add_flag("--sweater", s.sweater, "Dress the face's person in a skin-coloured sweater (cream to camel; needs --face)");
   cmd->add_option("--turn", s.turn_deg, "How far the viewing direction travels, degrees")->capture_default_str();
   cmd->add_option("--roll", s.roll_deg, "How far the camera rolls, degrees")->capture_default_str();
   cmd->add_option("--distance", s.distance_m, "Camera to hand, metres (average)")->capture_default_str();

@@ -138,6 +138,36 @@ TEST(SequenceTest, BackgroundsHaveNoSkinChroma) {
   EXPECT_GT(cv::countNonZero(skin), 1000);
 }
 
+// The person behind the hand in a sweater of a skin-like colour: more skin that is not a
+// hand, and nothing else changed (the same hand, path and background).
+TEST(SequenceTest, ASweaterIsSkinThatIsNotAHandAndChangesNothingElse) {
+  auto skin_pixels = [](const cv::Mat& bgr) {
+    cv::Mat ycrcb, skin;
+    cv::cvtColor(bgr, ycrcb, cv::COLOR_BGR2YCrCb);
+    cv::inRange(ycrcb, cv::Scalar(30, 133, 77), cv::Scalar(255, 173, 127), skin);
+    return cv::countNonZero(skin);
+  };
+  for (const cv::Vec3f& wool : {cv::Vec3f(185, 215, 235), cv::Vec3f(105, 150, 195)}) {
+    cv::Mat canvas = MakeBackground(BackgroundKind::kPlain, cv::Size(160, 120), 1);
+    DrawSweater(wool, cv::Point(80, 40), 40, &canvas);
+    EXPECT_GT(skin_pixels(canvas), 3000) << "cream to camel are in the skin box";
+  }
+  SequenceOptions plain = Small(testing::kTestSeed + 5);
+  plain.face = true;
+  SequenceOptions dressed = plain;
+  dressed.sweater = true;
+  Sequence a(RightHand(), plain), b(RightHand(), dressed);
+  for (int i : {0, 11}) {
+    const SequenceFrame fa = a.Render(i), fb = b.Render(i);
+    EXPECT_EQ(FrameTruthJson(fa), FrameTruthJson(fb)) << i;
+    EXPECT_EQ(cv::norm(fa.labels, fb.labels, cv::NORM_INF), 0.0) << i;
+    EXPECT_GT(skin_pixels(b.RenderEmpty(i)), skin_pixels(a.RenderEmpty(i)) + 2000) << i;
+  }
+  EXPECT_TRUE(b.Describe()["sweater"].get<bool>());
+  dressed.face = false;
+  testing::ExpectError([&] { Sequence(RightHand(), dressed); }, "a sweater needs a face");
+}
+
 TEST(SequenceTest, BadOptionsAreRefused) {
   SequenceOptions options = Small(1);
   options.frames = 0;

@@ -139,4 +139,20 @@ void DrawFace(const cv::Vec3f& skin_bgr, cv::Point centre, int height, cv::Mat* 
               cv::FILLED, cv::LINE_AA);
 }
 
+void DrawSweater(const cv::Vec3f& bgr_colour, cv::Point centre, int height, cv::Mat* bgr) {
+  NPHAND_THROW_CHECK(bgr != nullptr && bgr->type() == CV_8UC3, "sweater: needs an 8-bit BGR image");
+  NPHAND_THROW_CHECK(height >= 8, "sweater: height must be at least 8 pixels");
+  const cv::Scalar wool(bgr_colour[0], bgr_colour[1], bgr_colour[2]);
+  const cv::Scalar rib(0.85 * bgr_colour[0], 0.85 * bgr_colour[1], 0.85 * bgr_colour[2]);
+  const int h = height / 2, w = height * 3 / 8;  // the head's half-height and half-width, as DrawFace's
+  const int shoulders = centre.y + h * 3 / 2;
+  const int half_width = w * 5 / 2;
+  cv::ellipse(*bgr, cv::Point(centre.x, shoulders + h), cv::Size(half_width, h), 0, 180, 360, wool, cv::FILLED, cv::LINE_AA);
+  const cv::Rect chest(centre.x - half_width, shoulders + h, 2 * half_width, std::max(0, bgr->rows - shoulders - h));
+  cv::rectangle(*bgr, chest, wool, cv::FILLED);
+  for (int x = chest.x + w / 4; x < chest.x + chest.width; x += std::max(2, w / 4)) {
+    cv::line(*bgr, cv::Point(x, shoulders + h), cv::Point(x, bgr->rows - 1), rib, std::max(1, w / 16), cv::LINE_AA);
+  }
+}
+
 }  // namespace nphand

@@ -29,4 +29,9 @@ cv::Mat MakeBackground(BackgroundKind kind, cv::Size size, uint64_t seed);
 // `height` pixels centred at `centre` onto `bgr`: a skin region that is not a hand.
 void DrawFace(const cv::Vec3f& skin_bgr, cv::Point centre, int height, cv::Mat* bgr);
 
+// Draws the shoulders and chest of the person whose face DrawFace puts at `centre` with
+// `height`, in a sweater of colour `bgr_colour` (knitted ribs a little darker), down to the
+// image's bottom. Drawn before the face, so that the neck lies over its collar.
+void DrawSweater(const cv::Vec3f& bgr_colour, cv::Point centre, int height, cv::Mat* bgr);
+
 }  // namespace nphand

@@ -82,6 +82,8 @@ bool SequenceOptions::Check(std::string* why) const {
   } else if (!skin.empty() && std::none_of(kSkinTones.begin(), kSkinTones.end(),
                                            [&](const SkinTone& t) { return skin == t.name; })) {
     *why = "unknown skin tone '" + skin + "' (choose light, medium, olive, brown or dark)";
+  } else if (sweater && !face) {
+    *why = "a sweater needs a face (it is the person's)";
   } else {
     return true;
   }
@@ -136,7 +138,14 @@ Sequence::Sequence(const HandModel& hand, const SequenceOptions& options)
     for (int i = 0; i <= 100; ++i) drift += std::sin(1.3 * std::numbers::pi * i / 100.0 + phases_[2]);
     const int height = options.height * 2 / 5;
     const int side = drift > 0.0 ? -1 : 1;
-    DrawFace(skin_bgr_, cv::Point(size.width / 2 + side * size.width / 4, size.height * 2 / 5), height, &background_);
+    const cv::Point centre(size.width / 2 + side * size.width / 4, size.height * 2 / 5);
+    if (options.sweater) {
+      // Drawn last from the seed, so that sequences without one keep their bytes.
+      const double shade = random.Uniform();
+      const cv::Vec3f cream(185, 215, 235), camel(105, 150, 195);
+      DrawSweater(cream + shade * (camel - cream), centre, height, &background_);
+    }
+    DrawFace(skin_bgr_, centre, height, &background_);
   }
 }
 
@@ -263,6 +272,7 @@ nlohmann::json Sequence::Describe() const {
           {"skin", skin_},
           {"background", ToString(options_.background)},
           {"face", options_.face},
+          {"sweater", options_.sweater},
           {"turn_deg", options_.turn_deg},
           {"roll_deg", options_.roll_deg},
           {"distance_m", options_.distance_m},

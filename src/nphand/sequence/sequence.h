@@ -54,6 +54,7 @@ struct SequenceOptions {
   std::string skin;               // a SkinTones() name; empty: chosen by the seed
   BackgroundKind background = BackgroundKind::kTexture;
   bool face = false;              // a face beside the hand: skin that is not a hand
+  bool sweater = false;           // the face's person wears a sweater of a skin-like colour (cream to camel); needs face
   double turn_deg = 60.0;         // how far the viewing direction travels over the sequence
   double roll_deg = 90.0;         // how far the camera rolls over the sequence
   double distance_m = 0.45;       // camera to hand centre, on average
