@@ -135,12 +135,6 @@ TEST(RealScoreTest, MalformedLabelsAndPredictionsAreRefusedByLine) {
   testing::ExpectError([&] { ReadRealPredictions(dir / "p.jsonl", labels); }, "line 2: a second prediction");
 }
 
-// real-dev's folder: $NPHAND_REAL_DEV, or ../shared/real-dev beside the clone.
-std::filesystem::path RealDev() {
-  if (const char* env = std::getenv("NPHAND_REAL_DEV"); env != nullptr && *env != '\0') return env;
-  return NPHAND_REAL_DEV;
-}
-
 // Predictions made from the labels themselves, deterministically spoiled: joints moved by
 // noise of several sizes, some hands dropped, some moved off, sides flipped, an extra hand,
 // 3D bent; so that every measure and every matching rule has work.
@@ -197,7 +191,7 @@ void ExpectSame(const nlohmann::json& ours, const nlohmann::json& reference, con
 }
 
 TEST(RealScoreTest, FiguresAreTheReferenceScorersOnTheSamePredictions) {
-  const std::filesystem::path dev = RealDev();
+  const std::filesystem::path dev = testing::RealDevDir();
   if (!std::filesystem::exists(dev / "labels.jsonl") || !std::filesystem::exists(dev / "score_realdev.py")) {
     GTEST_SKIP() << dev << " is not here (real-dev is not shipped with nphand)";
   }

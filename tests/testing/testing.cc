@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
+
 #include <gtest/gtest.h>
 
 #include "nphand/util/check.h"
@@ -29,6 +31,11 @@ std::filesystem::path ScratchDir() {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+std::filesystem::path RealDevDir() {
+  if (const char* env = std::getenv("NPHAND_REAL_DEV"); env != nullptr && *env != '\0') return env;
+  return NPHAND_REAL_DEV;
 }
 
 void ExpectError(const std::function<void()>& call, const std::string& needle) {

@@ -16,6 +16,10 @@ const HandModel& LeftHand();
 // A fresh empty folder for the running test, under the system's temporary folder.
 std::filesystem::path ScratchDir();
 
+// real-dev's folder (real labelled hand images, never shipped): $NPHAND_REAL_DEV, or
+// ../shared/real-dev beside the clone, as CI has it. Tests that read it skip when it is absent.
+std::filesystem::path RealDevDir();
+
 // Expects `call` to throw nphand::Error with `needle` in its message.
 void ExpectError(const std::function<void()>& call, const std::string& needle);
 
