@@ -4,6 +4,11 @@
 // the full database does; what is tested is where the estimator looks, not its pose.
 #include "nphand/eval/real_eval.h"
 
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "nphand/db/builder.h"
@@ -18,9 +23,9 @@ TEST(RealEvalTest, TheHandIsFoundOnRealPhotographs) {
   if (!std::filesystem::exists(dev / "labels.jsonl")) {
     GTEST_SKIP() << dev << " is not here (real-dev is not shipped with nphand)";
   }
-  // One of each kind: a finger before the lips, hands before a wall, palm and
-  // back, pointing, a thumbs-up cut out, and hands holding objects against a green screen
-  // and a landscape.
+  // One of each kind: a finger before the lips, hands before a wall (palm and back,
+  // pointing, a grip), a thumbs-up cut out, and hands holding objects against a green
+  // screen and a landscape.
   const std::set<std::string> subset = {
       "images/hagrid_mute.png",         "images/hagrid_stop.png",       "images/hagrid_palm.png",
       "images/hagrid_one.png",          "images/hagrid_grip.png",       "images/hagrid_point.png",
