@@ -1,0 +1,263 @@
+#include "nphand/refine/refiner.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "nphand/scene/viewpoint.h"
+#include "nphand/util/check.h"
+
+namespace nphand {
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+// The parameters: the wrist's turns about the camera's x and y axes (across the view; the
+// turn within it is the place's), the joints, then the silhouette's place in the crop:
+// shift (x, y, crop pixels), log scale, turn (radians, counter-clockwise as displayed).
+constexpr int kWristAxes = 2;
+constexpr int kPlace = kWristAxes + kNumDofs;
+constexpr int kParameters = kPlace + 4;
+constexpr int kRepeats = 4;  // steps taken in a row along a direction that keeps improving
+using Parameters = std::array<double, kParameters>;
+
+// A direction of the search: parameters moved together, each by its weight times the step.
+enum class Kind : uint8_t { kWrist, kJoint, kShift, kScale, kTurn };
+struct Direction {
+  std::vector<std::pair<int, double>> moves;
+  Kind kind = Kind::kJoint;
+};
+
+// The silhouette's place; the wrist's two axes; the thumb's five joints one by one; for each
+// finger its curl (all three flexions), its MCP flexion, its PIP and DIP together, and its
+// spread.
+std::vector<Direction> Directions(const RefineOptions& options) {
+  std::vector<Direction> out;
+  if (options.move_place) {
+    out.push_back({{{kPlace, 1.0}}, Kind::kShift});
+    out.push_back({{{kPlace + 1, 1.0}}, Kind::kShift});
+    out.push_back({{{kPlace + 2, 1.0}}, Kind::kScale});
+    out.push_back({{{kPlace + 3, 1.0}}, Kind::kTurn});
+  }
+  if (options.move_wrist) {
+    for (int axis = 0; axis < kWristAxes; ++axis) out.push_back({{{axis, 1.0}}, Kind::kWrist});
+  }
+  if (options.move_fingers) {
+    for (int dof = 0; dof < 5; ++dof) out.push_back({{{kWristAxes + dof, 1.0}}, Kind::kJoint});
+    for (int finger = 0; finger < 4; ++finger) {
+      const int mcp = kWristAxes + 5 + 4 * finger, abd = mcp + 1, pip = mcp + 2, dip = mcp + 3;
+      out.push_back({{{mcp, 1.0}, {pip, 1.0}, {dip, 1.0}}, Kind::kJoint});
+      out.push_back({{{mcp, 1.0}}, Kind::kJoint});
+      out.push_back({{{pip, 1.0}, {dip, 1.0}}, Kind::kJoint});
+      out.push_back({{{abd, 0.5}}, Kind::kJoint});
+    }
+  }
+  return out;
+}
+
+// The affine map of 2 x 3 matrices a after b.
+cv::Matx23d Compose(const cv::Matx23d& a, const cv::Matx23d& b) {
+  const cv::Matx33d a3(a(0, 0), a(0, 1), a(0, 2), a(1, 0), a(1, 1), a(1, 2), 0, 0, 1);
+  const cv::Matx33d b3(b(0, 0), b(0, 1), b(0, 2), b(1, 0), b(1, 1), b(1, 2), 0, 0, 1);
+  const cv::Matx33d c = a3 * b3;
+  return cv::Matx23d(c(0, 0), c(0, 1), c(0, 2), c(1, 0), c(1, 1), c(1, 2));
+}
+
+}  // namespace
+
+bool RefineOptions::Check(std::string* why) const {
+  if (sweeps < 0 || sweeps > 50 || halvings < 0 || halvings > 10) {
+    *why = "refinement sweeps must be within 0..50 and halvings within 0..10";
+  } else if (!(wrist_step_deg > 0.0 && wrist_step_deg <= 90.0) || !(joint_step_deg > 0.0 && joint_step_deg <= 90.0)) {
+    *why = "refinement steps must be within (0, 90] degrees";
+  } else if (!(shift_step > 0.0 && shift_step <= 0.5) || !(scale_step > 0.0 && scale_step <= 1.0)) {
+    *why = "the refinement's place steps must be within (0, 0.5] of the crop and (0, 1] in log scale";
+  } else if (!(prior >= 0.0 && prior <= 100.0)) {
+    *why = "the refinement's prior weight must be within [0, 100]";
+  } else if (!(blur_px >= 0.0 && blur_px <= 8.0)) {
+    *why = "the refinement's blur must be within [0, 8] crop pixels";
+  } else if (render_side < 16 || render_side > 1024) {
+    *why = "the refinement's render side must be within 16..1024 pixels";
+  } else {
+    return true;
+  }
+  return false;
+}
+
+nlohmann::json ToJson(const RefineOptions& options) {
+  return {{"sweeps", options.sweeps},
+          {"halvings", options.halvings},
+          {"wrist_step_deg", options.wrist_step_deg},
+          {"joint_step_deg", options.joint_step_deg},
+          {"shift_step", options.shift_step},
+          {"scale_step", options.scale_step},
+          {"move_place", options.move_place},
+          {"move_wrist", options.move_wrist},
+          {"move_fingers", options.move_fingers},
+          {"prior", options.prior},
+          {"render_side", options.render_side},
+          {"blur_px", options.blur_px},
+          {"object_unknown", options.object_unknown}};
+}
+
+double Disagreement(const cv::Mat& a, const cv::Mat& b, const cv::Mat* unknown) {
+  NPHAND_CHECK(a.type() == CV_32FC1 && b.type() == CV_32FC1 && a.size() == b.size(), "crops of one size compare");
+  NPHAND_CHECK(unknown == nullptr || (unknown->type() == CV_32FC1 && unknown->size() == a.size()), "an unknown map of the crops' size");
+  double both = 0.0, either = 0.0;
+  for (int y = 0; y < a.rows; ++y) {
+    const float* p = a.ptr<float>(y);
+    const float* q = b.ptr<float>(y);
+    const float* u = unknown != nullptr ? unknown->ptr<float>(y) : nullptr;
+    for (int x = 0; x < a.cols; ++x) {
+      const double known = u != nullptr ? 1.0 - u[x] : 1.0;
+      both += known * std::min(p[x], q[x]);
+      either += known * std::max(p[x], q[x]);
+    }
+  }
+  return either > 0.0 ? 1.0 - both / either : 0.0;
+}
+
+Refiner::Refiner(const HandModel& hand, const Intrinsics& camera, double distance_m, const CropOptions& crop,
+                 const RefineOptions& options)
+    : hand_model_(hand), camera_(camera), distance_m_(distance_m), crop_(crop), options_(options), renderer_(hand) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "refine: ", why);
+  NPHAND_THROW_CHECK(camera.Check(&why), "refine: ", why);
+  NPHAND_THROW_CHECK(crop.Check(&why), "refine: ", why);
+  NPHAND_THROW_CHECK(distance_m > 0.0, "refine: the hand's distance must be positive");
+  const double shrink = static_cast<double>(options.render_side) / std::max(camera.width, camera.height);
+  small_ = camera;
+  small_.width = std::max(1, static_cast<int>(std::lround(camera.width * shrink)));
+  small_.height = std::max(1, static_cast<int>(std::lround(camera.height * shrink)));
+  small_.fx *= shrink;
+  small_.fy *= shrink;
+  small_.cx *= shrink;
+  small_.cy *= shrink;
+}
+
+cv::Mat Refiner::Silhouette(const Scene& scene, const cv::Matx23d& crop_from_small, cv::Mat* object) {
+  renderer_.RenderLabels(scene, small_, &labels_);
+  hand_.create(labels_.size(), CV_32FC2);
+  for (int y = 0; y < labels_.rows; ++y) {
+    const uint8_t* label = labels_.ptr<uint8_t>(y);
+    cv::Vec2f* out = hand_.ptr<cv::Vec2f>(y);
+    for (int x = 0; x < labels_.cols; ++x) {
+      out[x] = cv::Vec2f(label[x] == static_cast<uint8_t>(PixelLabel::kHand) ? 1.0f : 0.0f,
+                         label[x] == static_cast<uint8_t>(PixelLabel::kObject) ? 1.0f : 0.0f);
+    }
+  }
+  cv::Mat both;
+  cv::warpAffine(hand_, both, crop_from_small, cv::Size(crop_.size, crop_.size), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0.0);
+  cv::Mat planes[2];
+  cv::split(both, planes);
+  *object = planes[1];
+  return planes[0];
+}
+
+Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv::Matx23d& start_crop_from_image) {
+  NPHAND_THROW_CHECK(!target.image.empty() && target.image.type() == CV_32FC1 && target.image.rows == crop_.size &&
+                         target.image.cols == crop_.size,
+                     "refine: the target must be a ", crop_.size, " x ", crop_.size, " crop");
+  const std::vector<Direction> directions = Directions(options_);
+  // Both silhouettes blurred alike, so that the render's pixel steps and the target's
+  // resampling matter less than the shapes.
+  cv::Mat goal;  // never a view of the target's pixels: the blur must not write into them
+  if (options_.blur_px > 0.0) {
+    cv::GaussianBlur(target.image, goal, cv::Size(), options_.blur_px);
+  } else {
+    goal = target.image;
+  }
+  // A pixel of the search's small render to the camera's (pixel centres at integers).
+  const double grow_x = static_cast<double>(camera_.width) / small_.width;
+  const double grow_y = static_cast<double>(camera_.height) / small_.height;
+  const cv::Matx23d image_from_small(grow_x, 0, 0.5 * grow_x - 0.5, 0, grow_y, 0.5 * grow_y - 0.5);
+  Refinement out;
+  Scene scene = start;
+  const double centre = 0.5 * (crop_.size - 1);
+  // The start's crop map moved by the place parameters: shifted and scaled about the crop's centre.
+  auto crop_from_image = [&](const Parameters& p) {
+    const double k = std::exp(p[kPlace + 2]), c = k * std::cos(p[kPlace + 3]), s = k * std::sin(p[kPlace + 3]);
+    const cv::Matx23d place(c, s, centre - c * centre - s * centre + p[kPlace], -s, c, centre + s * centre - c * centre + p[kPlace + 1]);
+    return Compose(place, start_crop_from_image);
+  };
+  auto pose = [&](const Parameters& p) {
+    Eigen::Matrix3d turn = Eigen::Matrix3d::Identity();
+    for (int axis = 0; axis < kWristAxes; ++axis) turn = AxisAngle(Eigen::Vector3d::Unit(axis), p[axis]) * turn;
+    scene.hand.camera_from_hand = turn * start.hand.camera_from_hand;
+    for (int j = 0; j < kNumDofs; ++j) scene.hand.angles[j] = p[kWristAxes + j];
+    scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, hand_model_.bind_centre(), distance_m_);
+  };
+  Parameters origin{};
+  for (int j = 0; j < kNumDofs; ++j) origin[kWristAxes + j] = start.hand.angles[j];
+  // The pull towards the start's pose (not its place): the mean square of the moved angles
+  // over 90 degrees.
+  auto prior = [&](const Parameters& p) {
+    double squares = 0.0;
+    for (int i = 0; i < kPlace; ++i) squares += (p[i] - origin[i]) * (p[i] - origin[i]);
+    return options_.prior * squares / kPlace / (0.25 * std::numbers::pi * std::numbers::pi);
+  };
+  auto evaluate = [&](const Parameters& p, double* disagreement) {
+    pose(p);
+    ++out.renders;
+    cv::Mat object;
+    cv::Mat hand = Silhouette(scene, Compose(crop_from_image(p), image_from_small), &object);
+    if (options_.blur_px > 0.0) cv::GaussianBlur(hand, hand, cv::Size(), options_.blur_px);
+    *disagreement = Disagreement(hand, goal, options_.object_unknown ? &object : nullptr);
+    return *disagreement + prior(p);
+  };
+  Parameters best = origin;
+  double best_disagreement = 0.0;
+  double best_objective = evaluate(best, &best_disagreement);
+  out.objective_before = best_objective;
+  out.disagreement_before = best_disagreement;
+  for (int sweep = 0; sweep < options_.sweeps; ++sweep) {
+    const double scale = std::ldexp(1.0, -std::min(sweep, options_.halvings));
+    bool improved = false;
+    for (const Direction& direction : directions) {
+      const double step = scale * (direction.kind == Kind::kWrist   ? options_.wrist_step_deg * kDegToRad
+                                   : direction.kind == Kind::kJoint ? options_.joint_step_deg * kDegToRad
+                                   : direction.kind == Kind::kShift ? options_.shift_step * crop_.size
+                                   : direction.kind == Kind::kScale ? options_.scale_step
+                                                                    : options_.wrist_step_deg * kDegToRad);
+      // A step each way; the first that improves is taken, and repeated while it still does.
+      for (double sign : {1.0, -1.0}) {
+        bool moved = false;
+        for (int repeat = 0; repeat < kRepeats; ++repeat) {
+          Parameters trial = best;
+          for (const auto& [index, weight] : direction.moves) trial[index] += sign * weight * step;
+          JointAngles angles;
+          for (int j = 0; j < kNumDofs; ++j) angles[j] = trial[kWristAxes + j];
+          angles = ClampToLimits(angles);
+          for (int j = 0; j < kNumDofs; ++j) trial[kWristAxes + j] = angles[j];
+          if (trial == best) break;
+          double disagreement = 0.0;
+          const double objective = evaluate(trial, &disagreement);
+          if (objective >= best_objective) break;
+          best = trial;
+          best_objective = objective;
+          best_disagreement = disagreement;
+          moved = true;
+        }
+        if (moved) {
+          improved = true;
+          break;
+        }
+      }
+    }
+    if (!improved && scale <= std::ldexp(1.0, -options_.halvings)) break;
+  }
+  out.objective_after = best_objective;
+  out.disagreement_after = best_disagreement;
+  out.moved = best != origin;
+  pose(best);
+  out.scene = scene;
+  out.crop_from_image = crop_from_image(best);
+  out.turn = best[kPlace + 3];
+  return out;
+}
+
+}  // namespace nphand

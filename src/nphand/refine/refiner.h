@@ -1,0 +1,98 @@
+// Refinement beyond the database: a pose moved by local search until its rendered
+// silhouette agrees with the frame's hand mask better than the database's nearest view did.
+// The comparison is made where the descriptor is made, in the hand's normalised crop (its
+// square window, turned by its principal axis), through the start's own crop map, so that
+// a finger's move does not rescale the silhouette. What moves: the silhouette's place in
+// the crop (shift, scale, turn within the view), the wrist across the view and, if asked,
+// the fingers' joints.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "nphand/features/crop.h"
+#include "nphand/model/hand_model.h"
+#include "nphand/render/renderer.h"
+#include "nphand/scene/scene.h"
+
+namespace nphand {
+
+struct RefineOptions {
+  int sweeps = 3;               // passes over every direction of the search
+  int halvings = 2;             // each pass after the first halves the steps, at most this many times
+  double wrist_step_deg = 8.0;  // first step of the wrist's rotation about each camera axis
+  double joint_step_deg = 12.0; // first step of the finger joints' directions
+  double shift_step = 0.03;     // first step of the silhouette's shift, a fraction of the crop
+  double scale_step = 0.05;     // first step of its scale, in log scale (its turn's: the wrist's)
+  bool move_place = true;       // the silhouette's shift, scale and turn in the crop
+  bool move_wrist = true;
+  // The fingers' joints: off by default, for the silhouette does not tell them well enough
+  // (the validation sweep, docs/estimator.md: joint error 2.2 -> 3.9 degrees on masks).
+  bool move_fingers = false;
+  // The pull towards the start: this weight times the mean square of the moved angles over
+  // 90 degrees, added to the disagreement (1 - IoU).
+  double prior = 0.05;
+  int render_side = 64;         // the search renders at this many pixels a side
+  double blur_px = 1.0;         // Gaussian sigma, crop pixels, of both silhouettes before comparing (0: none)
+  // The start's object is of the database's size, not the frame's: where it lies, the
+  // frame's hand may or may not be, and those pixels do not count.
+  bool object_unknown = true;
+  bool Check(std::string* why) const;
+};
+
+nlohmann::json ToJson(const RefineOptions& options);
+
+// A silhouette agreement of two crop coverages (CV_32FC1 of one size): 1 - the
+// intersection over union (sum of minima over sum of maxima), in [0, 1] (0: the same).
+// Pixels count by 1 - `unknown` (if given: where an object may hide the hand, 1).
+double Disagreement(const cv::Mat& a, const cv::Mat& b, const cv::Mat* unknown = nullptr);
+
+struct Refinement {
+  Scene scene;                       // the refined scene: the start's objects and distance
+  cv::Matx23d crop_from_image;       // the camera's pixels to the target's crop, the place included
+  double turn = 0.0;                 // radians the silhouette was turned in the crop (counter-clockwise as displayed)
+  double objective_before = 0.0;     // disagreement + prior at the start
+  double objective_after = 0.0;      // and at the end (never above the start's)
+  double disagreement_before = 0.0;  // 1 - IoU at the start
+  double disagreement_after = 0.0;
+  int renders = 0;
+  bool moved = false;                // the pose or place changed
+};
+
+class Refiner {
+ public:
+  // `hand` must outlive the refiner; `camera` is the camera the start scenes are placed
+  // for (the database's), `distance_m` the hand centre's distance from it, `crop` the crop
+  // the targets were made with. Throws nphand::Error for invalid options.
+  Refiner(const HandModel& hand, const Intrinsics& camera, double distance_m, const CropOptions& crop,
+          const RefineOptions& options = {});
+
+  // Moves `start`'s wrist rotation and joint angles (within their limits), and the
+  // silhouette's place, to agree with `target` (a crop made with the same crop options).
+  // `start_crop_from_image` maps the start's render by `camera` into the crop it was
+  // matched with (the database entry's); the search keeps it, so that a finger's move does
+  // not rescale the whole silhouette. The wrist stays centred at the distance; the objects
+  // stay with the hand and hide it as they do in the frame. Throws nphand::Error for a
+  // target of another size.
+  Refinement Refine(const HandCrop& target, const Scene& start, const cv::Matx23d& start_crop_from_image);
+
+  const RefineOptions& options() const { return options_; }
+
+ private:
+  // The coverage of `scene`'s hand in the crop, rendered at the search's resolution and
+  // warped by `crop_from_small`; `object` gets its object's.
+  cv::Mat Silhouette(const Scene& scene, const cv::Matx23d& crop_from_small, cv::Mat* object);
+
+  const HandModel& hand_model_;
+  Intrinsics camera_;
+  Intrinsics small_;  // camera_ scaled to render_side
+  double distance_m_;
+  CropOptions crop_;
+  RefineOptions options_;
+  Renderer renderer_;
+  cv::Mat labels_, hand_;  // the search's buffers
+};
+
+}  // namespace nphand
