@@ -78,13 +78,14 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
   EstimatorOptions estimator_options;
   estimator_options.k = options.k;
   SetHandChoice(options.hand, &estimator_options);
+  estimator_options.refine = options.refine;
   Estimator estimator(db, *index, hand, estimator_options);
   const double rss_loaded = PeakRssMb();
 
   // Frames come from rendered sequences, one at a time (rendering is not timed).
   constexpr int kWarmUp = 30;
   constexpr int kPerSequence = 60;
-  std::vector<double> segment, describe, search, weigh, place, total;
+  std::vector<double> segment, describe, search, weigh, refine, place, total;
   int detected = 0;
   std::optional<Sequence> sequence;
   for (int i = 0; i < kWarmUp + options.frames; ++i) {
@@ -105,6 +106,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
     describe.push_back(r.ms.describe);
     search.push_back(r.ms.search);
     weigh.push_back(r.ms.weigh);
+    refine.push_back(r.ms.refine);
     place.push_back(r.ms.place);
     total.push_back(r.ms.total);
   }
@@ -113,7 +115,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
   return {
       {"fps", 1000.0 * options.frames / total_ms},
       {"ms", {{"segment", Stage(segment)}, {"describe", Stage(describe)}, {"search", Stage(search)},
-              {"weigh", Stage(weigh)}, {"place", Stage(place)}, {"total", Stage(total)}}},
+              {"weigh", Stage(weigh)}, {"refine", Stage(refine)}, {"place", Stage(place)}, {"total", Stage(total)}}},
       {"frames", options.frames},
       {"detected", detected},
       {"width", options.width},
@@ -123,6 +125,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
       {"backend", index->Backend()},
       {"index_mb", index->MemoryBytes() / 1e6},
       {"k", options.k},
+      {"refine", options.refine},
       {"hand", options.hand},
       {"peak_rss_mb", PeakRssMb()},
       {"rss_after_load_mb", rss_loaded},

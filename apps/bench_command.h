@@ -37,6 +37,7 @@ struct BenchPipelineOptions {
   int height = 480;
   int k = 500;
   std::string hand = "right";   // right, left or auto
+  bool refine = false;          // the estimator refines its best view (refine/refiner.h)
   uint64_t seed = 1;
   // OpenCV's threads for the image work (colour, resizing, morphology, the face cascade);
   // 1 keeps the whole path on one core, as the speed goal asks.

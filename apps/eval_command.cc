@@ -120,6 +120,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
   EstimatorOptions estimator_options;
   if (!options.faces) estimator_options.skin.face_cascade.clear();
+  estimator_options.refine = options.refine;
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, *index, hand, estimator_options);
@@ -136,6 +137,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["database"] = options.db.filename().string();
   result.figures["index"] = index->Backend();
   result.figures["hand"] = options.hand;
+  result.figures["refine"] = options.refine;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {
     std::string lines;

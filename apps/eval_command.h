@@ -78,6 +78,7 @@ struct EvalRealCommandOptions {
   std::filesystem::path out_dir;  // if set: real.json, real_predictions.jsonl, real_contact.png there
   bool faces = true;              // set faces aside (OpenCV's cascade)
   std::string hand = "given";     // "given": the labelled side; "auto": the estimator chooses
+  bool refine = false;            // the estimator refines its best view (refine/refiner.h)
 };
 
 struct EvalRealResult {

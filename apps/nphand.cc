@@ -174,6 +174,9 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--hand-length", e.hand_length_m, "Wrist to middle fingertip, metres")->capture_default_str();
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
   cmd->add_flag("!--no-forearm-cut", e.cut_forearm, "Do not cut the forearm at the wrist");
+  cmd->add_flag("--refine,!--no-refine", e.refine, "Refine the best view's pose until its silhouette agrees with the hand's");
+  cmd->add_option("--refine-sweeps", e.refinement.sweeps, "Refinement: passes over the wrist's and fingers' directions")
+      ->capture_default_str();
   cmd->add_option("--fps", o.fps, "Frame rate of an image folder")->capture_default_str();
   cmd->add_option("--max-frames", o.max_frames, "Stop after this many frames (0: all)")->check(WholeNumber())->capture_default_str();
   cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
@@ -203,6 +206,7 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   pipeline->add_option("--height", p.height, "Frame height")->capture_default_str();
   pipeline->add_option("--k", p.k, "Neighbours per frame")->capture_default_str();
   pipeline->add_option("--hand", p.hand, "right, left or auto (both sides searched)")->capture_default_str();
+  pipeline->add_flag("--refine", p.refine, "Refine the best view's pose (its cost is ms.refine)");
   pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->check(WholeNumber())->capture_default_str();
   pipeline->add_option("--threads", p.threads, "OpenCV threads for the image work (1: one core)")->capture_default_str();
   pipeline->add_option("--asset-dir", p.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
@@ -361,6 +365,7 @@ void AddEvalEstimatorCommand(CLI::App* eval, nphand::EvalEstimatorCommandOptions
   cmd->add_option("--height", s.height, "Frame height")->capture_default_str();
   cmd->add_option("--seed", s.seed, "Sequence i uses seed + i")->check(WholeNumber())->capture_default_str();
   cmd->add_option("--settings", s.settings, "Settings to run (default: the whole sweep)")->delimiter(',');
+  cmd->add_flag("--masks", s.masks, "Estimate from the rendered hand masks (the paper's input) instead of the RGB frames");
   cmd->add_option("--out", o.out_dir, "Folder for the JSON");
   cmd->add_option("--name", o.name, "File name of the JSON")->capture_default_str();
   cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
@@ -397,6 +402,7 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   cmd->add_option("--out", o.out_dir, "Folder for real.json, real_predictions.jsonl and real_contact.png");
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
+  cmd->add_flag("--refine", o.refine, "Refine each estimate's best view against the hand's silhouette");
   cmd->add_option("--hand", o.hand, "given (each labelled side searched for) or auto (the estimator chooses, and is scored)")
       ->capture_default_str();
   cmd->add_flag("--json", json, "Print JSON instead of the table");

@@ -208,6 +208,7 @@ TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles
   EXPECT_EQ(result.figures["per_source"]["asl_video"]["hands"], 5);
   EXPECT_EQ(result.figures["per_hand"].size(), 8u);
   EXPECT_EQ(result.figures["hand"], "given");
+  EXPECT_EQ(result.figures["refine"], false);
   EXPECT_NE(result.table.find("GT overall"), std::string::npos);
   for (const char* file : {"real.json", "real_predictions.jsonl", "real_contact.png"}) {
     EXPECT_TRUE(std::filesystem::exists(options.out_dir / file)) << file;
@@ -222,6 +223,10 @@ TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles
   const nlohmann::json& video = auto_side.figures["per_source"]["asl_video"];
   EXPECT_EQ(video["handedness_n"], video["found"]);
   EXPECT_GT(video["handedness_n"], 0);
+  EvalRealCommandOptions refined = options;
+  refined.refine = true;
+  refined.out_dir.clear();
+  EXPECT_EQ(RunEvalReal(refined, nullptr).figures["refine"], true);
   chosen.hand = "both";
   testing::ExpectError([&] { RunEvalReal(chosen, nullptr); }, "--hand is given or auto");
   // A label naming a missing image is refused by name before any work; so is an output
@@ -268,14 +273,21 @@ TEST_F(EstimateCommandTest, BenchPipelineReportsEveryFigure) {
   for (const char* key : {"fps", "ms", "peak_rss_mb", "db_entries", "backend", "k", "machine"}) {
     EXPECT_TRUE(report.contains(key)) << key;
   }
-  for (const char* stage : {"segment", "describe", "search", "weigh", "place", "total"}) {
+  for (const char* stage : {"segment", "describe", "search", "weigh", "refine", "place", "total"}) {
     EXPECT_TRUE(report["ms"].contains(stage)) << stage;
   }
+  EXPECT_EQ(report["refine"], false);
+  EXPECT_EQ(report["ms"]["refine"]["median"], 0.0) << "no refinement, no time";
   EXPECT_EQ(report["backend"], "exact");
   EXPECT_GT(report["fps"].get<double>(), 0.0);
   // One OpenCV thread while it runs; the process's own count afterwards.
   EXPECT_EQ(report["threads"], 1);
   EXPECT_EQ(cv::getNumThreads(), threads_before);
+  options.refine = true;
+  const nlohmann::json refined = RunBenchPipeline(options);
+  EXPECT_EQ(refined["refine"], true);
+  ASSERT_GT(refined["detected"].get<int>(), 0);
+  EXPECT_GT(refined["ms"]["refine"]["mean"].get<double>(), 0.0);
   options.threads = 0;
   testing::ExpectError([&] { RunBenchPipeline(options); }, "1..256 threads");
 }
@@ -305,14 +317,16 @@ TEST_F(EstimateCommandTest, EvalNoiseReportsEveryFigureForEveryAlphaAndMethod) {
       EXPECT_TRUE(row.contains(key)) << key;
     }
   }
-  for (const char* method : {"PNP exact", "PNP", "NN feature", "NN pose", "mean pose", "LSQ", "GP", "RVM"}) {
+  for (const char* method : {"PNP exact", "PNP", "PNP + refine", "NN feature", "NN pose", "mean pose", "LSQ", "GP", "RVM"}) {
     EXPECT_TRUE(seen.count({method, 0.0}) && seen.count({method, 5.0})) << method;
   }
-  EXPECT_TRUE(seen.count({"PNP RGB", 0.0}) && !seen.count({"PNP RGB", 5.0})) << "noise is for masks";
+  for (const char* method : {"PNP RGB", "PNP RGB + refine"}) {
+    EXPECT_TRUE(seen.count({method, 0.0}) && !seen.count({method, 5.0})) << method << ": noise is for masks";
+  }
   for (const nlohmann::json& row : json["rows"]) {
     if (row["sequence"] != "all") continue;
     // Frames without a hand: frame 0's empty view of each of the 5 sequences, for RGB methods.
-    EXPECT_EQ(row["no_hand_frames"], row["method"] == "PNP RGB" ? 5 : 0) << row["method"];
+    EXPECT_EQ(row["no_hand_frames"], row["method"].get<std::string>().starts_with("PNP RGB") ? 5 : 0) << row["method"];
     EXPECT_LE(row["false_detections"].get<int>(), row["no_hand_frames"].get<int>());
   }
   EXPECT_EQ(json["sequences"].size(), 5u);

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "nphand/db/builder.h"
+#include "nphand/estimate/frame_json.h"
 #include "nphand/index/backends.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/sequence/sequence.h"
@@ -42,6 +43,17 @@ class EstimatorTest : public ::testing::Test {
     delete index_;
     delete db_;
     std::filesystem::remove(Path());
+  }
+  // A 320x240 sequence of grasp 1 (in the database), `frames` long.
+  static SequenceOptions SmallSequence(int frames) {
+    SequenceOptions options;
+    options.frames = frames;
+    options.grasp = 1;
+    options.width = 320;
+    options.height = 240;
+    options.distance_m = 0.35;
+    options.seed = testing::kTestSeed;
+    return options;
   }
   static EstimatorOptions Options() {
     EstimatorOptions options;
@@ -394,14 +406,7 @@ TEST_F(EstimatorTest, NoEstimateSitsOnTheFaceOrNeck) {
 
 TEST_F(EstimatorTest, RenderedSequenceFramesAreEstimatedWithEveryField) {
   Estimator estimator(*db_, *index_, RightHand(), Options());
-  SequenceOptions options;
-  options.frames = 6;
-  options.grasp = 1;
-  options.width = 320;
-  options.height = 240;
-  options.distance_m = 0.35;
-  options.seed = testing::kTestSeed;
-  Sequence sequence(RightHand(), options);
+  Sequence sequence(RightHand(), SmallSequence(6));
   int detected = 0;
   for (int i = 0; i < sequence.size(); ++i) {
     const SequenceFrame frame = sequence.Render(i);
@@ -422,6 +427,44 @@ TEST_F(EstimatorTest, RenderedSequenceFramesAreEstimatedWithEveryField) {
     for (const Eigen::Vector2d& k : r.keypoints_2d) EXPECT_TRUE(near.contains(cv::Point(k.x(), k.y())));
   }
   EXPECT_GE(detected, 5);
+}
+
+// Refinement on masks of a sequence whose views lie between the database's (64 directions:
+// gaps of about 25 degrees): the wrist and the keypoints come closer to the truth than the
+// lookup's, the objective never rises, and each line says what the refinement did.
+TEST_F(EstimatorTest, RefinementBringsViewsBetweenTheDatabasesCloser) {
+  EstimatorOptions plain = Options();
+  plain.hand_length_m = ModelHandLength(*db_);
+  EstimatorOptions refined = plain;
+  refined.refine = true;
+  Estimator lookup(*db_, *index_, RightHand(), plain), refine(*db_, *index_, RightHand(), refined);
+  Sequence sequence(RightHand(), SmallSequence(30));
+  double wrist[2] = {0.0, 0.0}, keypoints[2] = {0.0, 0.0};
+  int frames = 0;
+  for (int i = 0; i < sequence.size(); i += 2) {
+    const SequenceFrame frame = sequence.Render(i);
+    const cv::Mat mask = frame.labels == static_cast<int>(PixelLabel::kHand);
+    const FrameResult a = lookup.ProcessMask(mask, frame.time_s), b = refine.ProcessMask(mask, frame.time_s);
+    ASSERT_EQ(a.detected(), b.detected()) << i;
+    if (!a.detected()) continue;
+    EXPECT_FALSE(a.refine_objective.has_value());
+    ASSERT_TRUE(b.refine_objective.has_value());
+    EXPECT_LE(b.refine_objective->second, b.refine_objective->first) << i;
+    EXPECT_TRUE(b.pose.IsValid()) << i;
+    const nlohmann::json line = FrameResultJson(b, *db_, false);
+    EXPECT_EQ(line["refined"].get<bool>(), b.refined);
+    EXPECT_GE(line["ms"]["refine"].get<double>(), 0.0);
+    ++frames;
+    const FrameResult* results[2] = {&a, &b};
+    for (int m = 0; m < 2; ++m) {
+      wrist[m] += RotationAngleDeg(results[m]->pose.camera_from_hand, frame.pose.camera_from_hand);
+      for (int k = 0; k < kNumKeypoints; ++k) keypoints[m] += 1000.0 * (results[m]->keypoints_hand[k] - frame.keypoints[k]).norm() / kNumKeypoints;
+    }
+  }
+  ASSERT_GE(frames, 10);
+  // Measured: wrist 13.3 -> 11.6 degrees, keypoints 24.6 -> 21.1 mm.
+  EXPECT_LT(wrist[1], 0.95 * wrist[0]) << wrist[0] / frames << " -> " << wrist[1] / frames << " deg";
+  EXPECT_LT(keypoints[1], 0.95 * keypoints[0]) << keypoints[0] / frames << " -> " << keypoints[1] / frames << " mm";
 }
 
 TEST_F(EstimatorTest, BadSetUpsAreRefused) {

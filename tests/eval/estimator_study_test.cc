@@ -11,7 +11,18 @@
 namespace nphand {
 namespace {
 
-class EstimatorStudyTest : public testing::TinyDatabaseTest {};
+class EstimatorStudyTest : public testing::TinyDatabaseTest {
+ protected:
+  // Two sequences of four 160x120 frames.
+  static EstimatorStudyOptions Small() {
+    EstimatorStudyOptions options;
+    options.sequences = 2;
+    options.frames = 4;
+    options.width = 160;
+    options.height = 120;
+    return options;
+  }
+};
 
 TEST_F(EstimatorStudyTest, EverySettingIsNamedOnceAndVariesWhatItSays) {
   const EstimatorOptions base;
@@ -29,15 +40,32 @@ TEST_F(EstimatorStudyTest, EverySettingIsNamedOnceAndVariesWhatItSays) {
   EXPECT_EQ(find("turns0").options.roll_ambiguity, 0.0);
   EXPECT_EQ(find("k50").options.k, 50);
   EXPECT_EQ(find("carried20").options.carried, 20);
+  EXPECT_FALSE(find("nn").options.refine);
+  EXPECT_TRUE(find("refine").options.refine);
+  EXPECT_FALSE(find("refine").options.refinement.move_fingers);
+  EXPECT_TRUE(find("refine-fingers4").options.refinement.move_fingers);
+  EXPECT_EQ(find("refine-fingers4").options.refinement.joint_step_deg, 4.0);
+  EXPECT_FALSE(find("refine-place").options.refinement.move_wrist);
+  EXPECT_EQ(find("refine-render128-sweeps6").options.refinement.render_side, 128);
+}
+
+// On the rendered masks (the paper's input) every frame whose hand is in view is detected,
+// and refinement is reported as part of a setting's options.
+TEST_F(EstimatorStudyTest, MasksAreTheRenderedHandsOwn) {
+  const ExactIndex index(DatabaseDescriptors(db()));
+  EstimatorStudyOptions options = Small();
+  options.masks = true;
+  options.settings = {"nn", "refine"};
+  const std::vector<EstimatorScore> scores = RunEstimatorStudy(db(), index, testing::RightHand(), {}, options, nullptr);
+  ASSERT_EQ(scores.size(), 2u);
+  EXPECT_EQ(scores[0].options["refine"], false);
+  EXPECT_EQ(scores[1].options["refine"]["render_side"], 64);
+  for (const EstimatorScore& s : scores) EXPECT_GT(s.detected, 0) << s.name;
 }
 
 TEST_F(EstimatorStudyTest, RunsTheNamedSettingsOverTheSequences) {
   const ExactIndex index(DatabaseDescriptors(db()));
-  EstimatorStudyOptions options;
-  options.sequences = 2;
-  options.frames = 4;
-  options.width = 160;
-  options.height = 120;
+  EstimatorStudyOptions options = Small();
   options.settings = {"nn", "turns0", "turns0.3"};
   const std::vector<EstimatorScore> scores = RunEstimatorStudy(db(), index, testing::RightHand(), {}, options, nullptr);
   ASSERT_EQ(scores.size(), 3u);

@@ -163,7 +163,7 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the side's memory must be within [0, 1) and its switching margin within [0, 10)";
   } else if (learn_interval < 1) {
     *why = "the learning interval must be at least 1 frame";
-  } else if (!skin.Check(why) || !forearm.Check(why)) {
+  } else if (!skin.Check(why) || !forearm.Check(why) || !refinement.Check(why)) {
     return false;
   } else {
     return true;
@@ -203,6 +203,7 @@ Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel&
   db_intrinsics_ = Intrinsics::FromFieldOfView(render["image_size"].get<int>(), render["image_size"].get<int>(),
                                                render["fov_deg"].get<double>() * std::numbers::pi / 180.0);
   db_distance_ = render["distance_m"].get<double>();
+  if (options.refine) refiner_.emplace(hand, db_intrinsics_, db_distance_, db.descriptor().Crop(), options.refinement);
   directions_ = ViewSphereDirections(db.header()["viewpoints"].get<int>());
   grasps_.resize(kNumGrasps + 1);
   model_hand_length_ = ModelHandLength(db);
@@ -602,12 +603,32 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   result.pose = result.top[0].pose;
   result.ms.weigh = Ms(t, Clock::now());
 
+  const HandCrop& query_crop = crops[best.turn_of];
+  // Refinement: the best entry's pose moved until its silhouette agrees with the query's;
+  // it then stands for the entry in what follows.
+  std::optional<EntryPlacement> refined;
+  double turn = best.turn;  // the image-plane turn from the database's camera to the frame's
+  if (refiner_.has_value()) {
+    t = Clock::now();
+    const Refinement r = refiner_->Refine(query_crop, EntryScene(best.entry), PlacementOf(best.entry).crop_from_image);
+    result.refined = r.moved;
+    result.refine_objective = std::make_pair(r.objective_before, r.objective_after);
+    if (r.moved) {
+      refined = EntryPlacement{best.entry, 0, r.crop_from_image, hand_.KeypointsOf(r.scene.hand), r.scene.wrist_in_camera};
+      // The silhouette turned counter-clockwise in the crop stands for a hand turned the
+      // other way in the frame.
+      turn = best.turn - r.turn;
+      result.pose.angles = r.scene.hand.angles;
+      result.pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), turn) * r.scene.hand.camera_from_hand;
+    }
+    result.ms.refine = Ms(t, Clock::now());
+  }
+
   // Placement: the best entry rendered as the database saw it tells where its keypoints lie
   // in its crop; the query's crop maps them into the frame, and the two crops' scales give
   // the distance.
   t = Clock::now();
-  const EntryPlacement& entry = PlacementOf(best.entry);
-  const HandCrop& query_crop = crops[best.turn_of];
+  const EntryPlacement& entry = refined.has_value() ? *refined : PlacementOf(best.entry);
   const cv::Matx23d frame_from_crop = Invert(query_crop.crop_from_image);
   const double size = options_.hand_length_m / model_hand_length_;
   const Intrinsics& camera = intrinsics_for(frame);
@@ -628,7 +649,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   // scales and the hand's size.
   const double range = db_distance_ * (camera.fx / db_intrinsics_.fx) * size *
                        (Scale(query_crop.crop_from_image) / Scale(entry.crop_from_image));
-  const Eigen::Matrix3d rotation = towards_ray * AxisAngle(Eigen::Vector3d::UnitZ(), best.turn);
+  const Eigen::Matrix3d rotation = towards_ray * AxisAngle(Eigen::Vector3d::UnitZ(), turn);
   result.pose.camera_from_hand = towards_ray * result.pose.camera_from_hand;
   for (Hypothesis& h : result.top) h.pose.camera_from_hand = towards_ray * h.pose.camera_from_hand;
   const Eigen::Vector3d wrist = range * ray - size * (result.pose.camera_from_hand * hand_.bind_centre());

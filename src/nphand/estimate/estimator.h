@@ -23,6 +23,7 @@
 #include "nphand/render/camera.h"
 #include "nphand/render/renderer.h"
 #include "nphand/scene/grasp.h"
+#include "nphand/refine/refiner.h"
 #include "nphand/segment/forearm.h"
 #include "nphand/segment/skin.h"
 
@@ -82,6 +83,11 @@ struct EstimatorOptions {
   bool cut_forearm = true;
   ForearmCutOptions forearm;
   int learn_interval = 10;                      // frames between skin-colour updates from confident frames
+  // Refinement beyond the database (refine/refiner.h): the best hypothesis's pose moved
+  // until its silhouette agrees with the hand's; keypoints, angles and rotation then come
+  // from the refined pose.
+  bool refine = false;
+  RefineOptions refinement;
   bool Check(std::string* why) const;
 };
 
@@ -105,7 +111,7 @@ struct Hypothesis {
 };
 
 struct StageMilliseconds {
-  double segment = 0.0, describe = 0.0, search = 0.0, weigh = 0.0, place = 0.0, total = 0.0;
+  double segment = 0.0, describe = 0.0, search = 0.0, weigh = 0.0, refine = 0.0, place = 0.0, total = 0.0;
 };
 
 struct FrameResult {
@@ -134,6 +140,10 @@ struct FrameResult {
   double nearest_distance = 0.0;               // the best neighbour's feature distance (if searched)
   double effective_samples = 0.0;              // 1 / sum w^2 over the hypotheses
   double confidence = 0.0;                     // the posterior mass near the estimate, 0..1
+  // With refine: whether the refinement moved the pose, and its objective (silhouette
+  // disagreement, 1 - IoU, plus the pull towards the start) before and after.
+  bool refined = false;
+  std::optional<std::pair<double, double>> refine_objective;
   StageMilliseconds ms;
 };
 
@@ -231,6 +241,7 @@ class Estimator {
   mutable Intrinsics frame_intrinsics_;
   std::vector<EntryPlacement> placements_;
   uint64_t placements_clock_ = 0;  // counts the placements asked for
+  std::optional<Refiner> refiner_;  // with refine
   std::vector<WeightedPose> carried_;
   std::optional<cv::Point2d> last_centre_;
   Handedness side_ = Handedness::kRight;  // the track's side

@@ -36,8 +36,8 @@ nlohmann::json Posterior(const std::vector<std::pair<std::string, double>>& p, c
 
 nlohmann::json FrameResultJson(const FrameResult& r, const Database& db, bool with_top) {
   nlohmann::json j = {{"frame", r.frame}, {"time_s", r.time_s}, {"detected", r.detected()}, {"status", ToString(r.status)}};
-  j["ms"] = {{"segment", r.ms.segment}, {"describe", r.ms.describe}, {"search", r.ms.search},
-             {"weigh", r.ms.weigh},     {"place", r.ms.place},       {"total", r.ms.total}};
+  j["ms"] = {{"segment", r.ms.segment}, {"describe", r.ms.describe}, {"search", r.ms.search}, {"weigh", r.ms.weigh},
+             {"refine", r.ms.refine},   {"place", r.ms.place},       {"total", r.ms.total}};
   if (!r.detected()) {
     j["reason"] = r.reason;
     if (r.status == FrameStatus::kNotAHand) j["nearest_distance"] = r.nearest_distance;
@@ -58,6 +58,10 @@ nlohmann::json FrameResultJson(const FrameResult& r, const Database& db, bool wi
   j["keypoints_3d_camera_m"] = Points(r.keypoints_camera);
   j["depth_m"] = r.depth_m;
   j["box_px"] = {r.box.x, r.box.y, r.box.width, r.box.height};
+  if (r.refine_objective.has_value()) {
+    j["refined"] = r.refined;
+    j["refine_objective"] = {{"before", r.refine_objective->first}, {"after", r.refine_objective->second}};
+  }
   j["grasps"] = Posterior(r.grasps, "grasp");
   j["objects"] = Posterior(r.objects, "object");
   j["confidence"] = r.confidence;

@@ -62,6 +62,34 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     name << "turns" << ambiguity;
     around_default(name.str(), [&](EstimatorOptions& e) { e.roll_ambiguity = ambiguity; });
   }
+  // Refinement beyond the database (refine/refiner.h): its default (the place and the
+  // wrist), the place alone, with the fingers too (in two step sizes), finer renders and
+  // more passes.
+  around_default("refine", [&](EstimatorOptions& e) { e.refine = true; });
+  around_default("refine-place", [&](EstimatorOptions& e) {
+    e.refine = true;
+    e.refinement.move_wrist = false;
+  });
+  for (double step : {4.0, 12.0}) {
+    std::ostringstream name;
+    name << "refine-fingers" << step;
+    around_default(name.str(), [&](EstimatorOptions& e) {
+      e.refine = true;
+      e.refinement.move_fingers = true;
+      e.refinement.joint_step_deg = step;
+    });
+  }
+  for (int side : {64, 128}) {
+    for (int sweeps : {3, 6}) {
+      if (side == RefineOptions{}.render_side && sweeps == RefineOptions{}.sweeps) continue;  // the default's
+      around_default("refine-render" + std::to_string(side) + "-sweeps" + std::to_string(sweeps), [&](EstimatorOptions& e) {
+        e.refine = true;
+        e.refinement.render_side = side;
+        e.refinement.sweeps = sweeps;
+        e.refinement.halvings = sweeps > 3 ? 4 : 2;
+      });
+    }
+  }
   for (int k : {50, 100}) {
     around_default("k" + std::to_string(k), [&](EstimatorOptions& e) {
       e.k = k;
@@ -129,12 +157,14 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     score.name = setting.name;
     score.options = {{"k", e.k},           {"observation", ToString(e.observation)}, {"sigma_y", e.sigma_y},
                      {"prior", ToString(e.prior)}, {"sigma_x", e.sigma_x}, {"prior_share", e.prior_share},
-                     {"carried", e.carried},        {"roll_ambiguity", e.roll_ambiguity}};
+                     {"carried", e.carried},        {"roll_ambiguity", e.roll_ambiguity},
+                     {"refine", e.refine ? ToJson(e.refinement) : nlohmann::json(false)}};
     std::vector<double> ms;
     for (const std::vector<SequenceFrame>& frames : sequences) {
       estimator.Reset();
       for (const SequenceFrame& truth : frames) {
-        const FrameResult r = estimator.Process(truth.rgb, truth.time_s);
+        const FrameResult r = options.masks ? estimator.ProcessMask(truth.labels == static_cast<int>(PixelLabel::kHand), truth.time_s)
+                                            : estimator.Process(truth.rgb, truth.time_s);
         ++score.frames;
         ms.push_back(r.ms.total);
         if (!r.detected()) continue;

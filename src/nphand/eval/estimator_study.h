@@ -36,6 +36,7 @@ struct EstimatorStudyOptions {
   int height = 480;
   uint64_t seed = 7000;   // sequence i uses seed + i (the evaluation uses other seeds)
   std::vector<std::string> settings;  // names from EstimatorSweep(); empty: all
+  bool masks = false;     // the rendered hand's mask (the paper's input) instead of the RGB frame
   bool Check(std::string* why) const;
 };
 

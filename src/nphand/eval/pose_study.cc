@@ -117,7 +117,8 @@ class EstimatorMethod : public PoseMethod {
     const EstimatorOptions& o = estimator_.options();
     return {{"index", backend_},         {"k", o.k},           {"observation", ToString(o.observation)},
             {"sigma_y", o.sigma_y},      {"prior", ToString(o.prior)}, {"sigma_x", o.sigma_x},
-            {"carried", o.carried},      {"input", from_rgb_ ? "rgb" : "mask"}};
+            {"carried", o.carried},      {"input", from_rgb_ ? "rgb" : "mask"},
+            {"refine", o.refine ? ToJson(o.refinement) : nlohmann::json(false)}};
   }
 
  private:
@@ -654,8 +655,12 @@ PoseStudyResult RunPoseStudy(PoseStudyPart part, const Database& db, const KnnIn
     exact = std::make_unique<ExactIndex>(DatabaseDescriptors(db));
     methods.push_back(MakeEstimatorMethod("PNP exact", db, *exact, hand, pnp, false));
   }
+  EstimatorOptions refined = pnp;
+  refined.refine = true;
   methods.push_back(MakeEstimatorMethod("PNP", db, index, hand, pnp, false));
+  methods.push_back(MakeEstimatorMethod("PNP + refine", db, index, hand, refined, false));
   methods.push_back(MakeEstimatorMethod("PNP RGB", db, index, hand, pnp, true));
+  methods.push_back(MakeEstimatorMethod("PNP RGB + refine", db, index, hand, refined, true));
   methods.push_back(MakeEstimatorMethod("NN feature", db, index, hand, nn_feature, false));
   methods.push_back(MakeNearestPoseMethod(db));
   if (part != PoseStudyPart::kRobustness) {
