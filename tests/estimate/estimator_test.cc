@@ -462,8 +462,8 @@ TEST_F(EstimatorTest, RefinementBringsViewsBetweenTheDatabasesCloser) {
     }
   }
   ASSERT_GE(frames, 10);
-  // Measured: wrist 13.3 -> 11.6 degrees, keypoints 24.6 -> 21.1 mm.
-  EXPECT_LT(wrist[1], 0.95 * wrist[0]) << wrist[0] / frames << " -> " << wrist[1] / frames << " deg";
+  // Measured: wrist 13.3 -> 9.8 degrees, keypoints 24.6 -> 22.4 mm.
+  EXPECT_LT(wrist[1], 0.85 * wrist[0]) << wrist[0] / frames << " -> " << wrist[1] / frames << " deg";
   EXPECT_LT(keypoints[1], 0.95 * keypoints[0]) << keypoints[0] / frames << " -> " << keypoints[1] / frames << " mm";
 }
 

@@ -74,6 +74,7 @@ TEST_F(EstimatorStudyTest, RunsTheNamedSettingsOverTheSequences) {
     EXPECT_LE(s.detected, s.frames);
     EXPECT_LE(s.both_turns, s.detected);
     EXPECT_GE(s.keypoint_mm, 0.0);
+    EXPECT_GE(s.jitter_mm, 0.0);
   }
   EXPECT_EQ(scores[1].name, "turns0");
   EXPECT_EQ(scores[1].both_turns, 0) << "never the half turn";
@@ -82,6 +83,7 @@ TEST_F(EstimatorStudyTest, RunsTheNamedSettingsOverTheSequences) {
   const nlohmann::json json = ToJson(scores);
   EXPECT_EQ(json.size(), 3u);
   EXPECT_TRUE(json[0].contains("both_turns"));
+  EXPECT_TRUE(json[0].contains("jitter_mm"));
   EXPECT_NE(FormatTable(scores).find("turns0.3"), std::string::npos);
 
   options.settings = {"nonesuch"};

@@ -88,6 +88,27 @@ TEST(RefinerTest, APerturbedWristIsRecovered) {
   }
 }
 
+// The pull towards the previous frame's rotation holds the wrist back when strong, and a
+// previous rotation far from the start (a new view of the track) is ignored.
+TEST(RefinerTest, ThePreviousFramesRotationPulls) {
+  const Eigen::Matrix3d view = CameraFromHand(ViewpointFromDirection(Eigen::Vector3d(0.3, -0.4, 1.0), 0.4));
+  const HandCrop target = CropOf(SceneOf(HalfClosed(), view));
+  const Scene start = SceneOf(HalfClosed(), AxisAngle(Eigen::Vector3d(0, 1, 0), 10.0 * kDeg) * view);
+  const cv::Matx23d start_map = CropOf(start).crop_from_image;
+  Refiner free(RightHand(), Camera(), kDistance, Crop());
+  const Refinement alone = free.Refine(target, start, start_map);
+  const Eigen::Matrix3d far = AxisAngle(Eigen::Vector3d(1, 0, 0), 90.0 * kDeg) * start.hand.camera_from_hand;
+  const Refinement ignored = free.Refine(target, start, start_map, &far);
+  EXPECT_EQ(ignored.objective_after, alone.objective_after);
+  EXPECT_TRUE(RotationOf(ignored) == RotationOf(alone));
+  RefineOptions strong;
+  strong.track = 50.0;
+  Refiner held(RightHand(), Camera(), kDistance, Crop(), strong);
+  const Refinement pulled = held.Refine(target, start, start_map, &start.hand.camera_from_hand);
+  EXPECT_LT(RotationAngleDeg(RotationOf(pulled), start.hand.camera_from_hand),
+            0.5 * RotationAngleDeg(RotationOf(alone), start.hand.camera_from_hand));
+}
+
 // Starts off in every way (wrist, fingers, place), the fingers moving too: never worse than
 // the start, always within the joints' limits.
 TEST(RefinerTest, TheObjectiveNeverRisesAndLimitsHold) {

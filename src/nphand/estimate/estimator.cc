@@ -248,6 +248,8 @@ void Estimator::Reset() {
   side_ = options_.hand;
   side_evidence_ = 0.0;
   side_frame_ = -1;
+  refined_ = {};
+  refined_before_ = {};
 }
 
 const Intrinsics& Estimator::intrinsics_for(cv::Size frame) const {
@@ -610,7 +612,14 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   double turn = best.turn;  // the image-plane turn from the database's camera to the frame's
   if (refiner_.has_value()) {
     t = Clock::now();
-    const Refinement r = refiner_->Refine(query_crop, EntryScene(best.entry), PlacementOf(best.entry).crop_from_image);
+    // While the track holds (the prior took part), the side's refined rotation of the frame
+    // before, in this entry's image plane.
+    const size_t side = result.hand == Handedness::kRight ? 0 : 1;
+    if (refined_[side].frame != result.frame) refined_before_[side] = refined_[side];
+    const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -best.turn) * refined_before_[side].rotation;
+    const bool track = result.prior_used && refined_before_[side].frame == result.frame - 1;
+    const Refinement r = refiner_->Refine(query_crop, EntryScene(best.entry), PlacementOf(best.entry).crop_from_image,
+                                          track ? &previous : nullptr);
     result.refined = r.moved;
     result.refine_objective = std::make_pair(r.objective_before, r.objective_after);
     if (r.moved) {
@@ -619,8 +628,9 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
       // other way in the frame.
       turn = best.turn - r.turn;
       result.pose.angles = r.scene.hand.angles;
-      result.pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), turn) * r.scene.hand.camera_from_hand;
+      result.pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), best.turn) * RotationOf(r);
     }
+    refined_[side] = {result.pose.camera_from_hand, result.frame};
     result.ms.refine = Ms(t, Clock::now());
   }
 

@@ -242,6 +242,13 @@ class Estimator {
   std::vector<EntryPlacement> placements_;
   uint64_t placements_clock_ = 0;  // counts the placements asked for
   std::optional<Refiner> refiner_;  // with refine
+  // A refinement's rotation, turned as reported (before the ray), and its frame.
+  struct Refined {
+    Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+    int frame = -2;  // none
+  };
+  std::array<Refined, 2> refined_;         // by side (right, left): the latest
+  std::array<Refined, 2> refined_before_;  // by side: the latest of an earlier frame than refined_'s
   std::vector<WeightedPose> carried_;
   std::optional<cv::Point2d> last_centre_;
   Handedness side_ = Handedness::kRight;  // the track's side

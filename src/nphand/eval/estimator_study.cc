@@ -63,8 +63,8 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     around_default(name.str(), [&](EstimatorOptions& e) { e.roll_ambiguity = ambiguity; });
   }
   // Refinement beyond the database (refine/refiner.h): its default (the place and the
-  // wrist), the place alone, with the fingers too (in two step sizes), finer renders and
-  // more passes.
+  // wrist, pulled towards the last frame's), the place alone, with the fingers too (in two
+  // step sizes), other pulls, finer renders and more passes.
   around_default("refine", [&](EstimatorOptions& e) { e.refine = true; });
   around_default("refine-place", [&](EstimatorOptions& e) {
     e.refine = true;
@@ -77,6 +77,14 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
       e.refine = true;
       e.refinement.move_fingers = true;
       e.refinement.joint_step_deg = step;
+    });
+  }
+  for (double track : {0.0, 0.5, 8.0}) {
+    std::ostringstream name;
+    name << "refine-track" << track;
+    around_default(name.str(), [&](EstimatorOptions& e) {
+      e.refine = true;
+      e.refinement.track = track;
     });
   }
   for (int side : {64, 128}) {
@@ -160,14 +168,30 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
                      {"carried", e.carried},        {"roll_ambiguity", e.roll_ambiguity},
                      {"refine", e.refine ? ToJson(e.refinement) : nlohmann::json(false)}};
     std::vector<double> ms;
+    double jitter = 0.0;
+    int jitter_count = 0;
+    std::vector<Keypoints3d> run;  // the keypoints of the current run of detected frames
+    auto close_run = [&]() {
+      if (run.size() >= 3) {
+        const int n = static_cast<int>(run.size()) - 2;
+        jitter += Jitter(run) * n;
+        jitter_count += n;
+      }
+      run.clear();
+    };
     for (const std::vector<SequenceFrame>& frames : sequences) {
       estimator.Reset();
+      close_run();
       for (const SequenceFrame& truth : frames) {
         const FrameResult r = options.masks ? estimator.ProcessMask(truth.labels == static_cast<int>(PixelLabel::kHand), truth.time_s)
                                             : estimator.Process(truth.rgb, truth.time_s);
         ++score.frames;
         ms.push_back(r.ms.total);
-        if (!r.detected()) continue;
+        if (!r.detected()) {
+          close_run();
+          continue;
+        }
+        run.push_back(r.keypoints_hand);
         ++score.detected;
         score.both_turns += r.both_turns;
         double joint = 0.0, keypoint = 0.0, px = 0.0, camera = 0.0;
@@ -189,6 +213,8 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
         *v /= score.detected;
       }
     }
+    close_run();
+    score.jitter_mm = jitter_count > 0 ? 1000.0 * jitter / jitter_count : 0.0;
     score.ms_median = Median(ms);
     scores.push_back(score);
     line.Update(scores.size());
@@ -210,6 +236,7 @@ nlohmann::json ToJson(const std::vector<EstimatorScore>& scores) {
                     {"keypoint_mm", s.keypoint_mm},
                     {"keypoint_px", s.keypoint_px},
                     {"camera_mm", s.camera_mm},
+                    {"jitter_mm", s.jitter_mm},
                     {"ms_median", s.ms_median}});
   }
   return rows;
@@ -219,14 +246,14 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
   std::ostringstream out;
   out << std::left << std::setw(22) << "setting" << std::right << std::setw(10) << "detected" << std::setw(10)
       << "joint_deg" << std::setw(10) << "wrist_deg" << std::setw(12) << "keypoint_mm" << std::setw(12) << "keypoint_px"
-      << std::setw(11) << "camera_mm" << std::setw(8) << "ms" << std::setw(8) << "2turns" << "\n";
+      << std::setw(11) << "camera_mm" << std::setw(8) << "jitter" << std::setw(8) << "ms" << std::setw(8) << "2turns" << "\n";
   out << std::fixed;
   for (const EstimatorScore& s : scores) {
     out << std::left << std::setw(22) << s.name << std::right << std::setw(10)
         << (std::to_string(s.detected) + "/" + std::to_string(s.frames)) << std::setprecision(2) << std::setw(10)
         << s.joint_deg << std::setw(10) << s.wrist_deg << std::setprecision(1) << std::setw(12) << s.keypoint_mm
-        << std::setw(12) << s.keypoint_px << std::setw(11) << s.camera_mm << std::setprecision(2) << std::setw(8)
-        << s.ms_median << std::setprecision(0) << std::setw(7)
+        << std::setw(12) << s.keypoint_px << std::setw(11) << s.camera_mm << std::setw(8) << s.jitter_mm
+        << std::setprecision(2) << std::setw(8) << s.ms_median << std::setprecision(0) << std::setw(7)
         << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%\n";
   }
   return out.str();

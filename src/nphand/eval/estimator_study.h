@@ -51,6 +51,7 @@ struct EstimatorScore {
   double keypoint_mm = 0.0;    // mean 3D keypoint error about the wrist (the paper's joint-position measure)
   double keypoint_px = 0.0;    // mean 2D keypoint error in the frame
   double camera_mm = 0.0;      // mean 3D keypoint error in the camera frame (includes the distance)
+  double jitter_mm = 0.0;      // keypoints about the wrist: mean second difference over runs of detected frames (mm/frame²)
   double ms_median = 0.0;      // per frame, the whole estimator
 };
 

@@ -76,8 +76,10 @@ bool RefineOptions::Check(std::string* why) const {
     *why = "refinement steps must be within (0, 90] degrees";
   } else if (!(shift_step > 0.0 && shift_step <= 0.5) || !(scale_step > 0.0 && scale_step <= 1.0)) {
     *why = "the refinement's place steps must be within (0, 0.5] of the crop and (0, 1] in log scale";
-  } else if (!(prior >= 0.0 && prior <= 100.0)) {
-    *why = "the refinement's prior weight must be within [0, 100]";
+  } else if (!(prior >= 0.0 && prior <= 100.0) || !(track >= 0.0 && track <= 100.0)) {
+    *why = "the refinement's prior and track weights must be within [0, 100]";
+  } else if (!(track_within_deg >= 0.0 && track_within_deg <= 180.0)) {
+    *why = "the refinement's track bound must be within [0, 180] degrees";
   } else if (!(blur_px >= 0.0 && blur_px <= 8.0)) {
     *why = "the refinement's blur must be within [0, 8] crop pixels";
   } else if (render_side < 16 || render_side > 1024) {
@@ -99,6 +101,8 @@ nlohmann::json ToJson(const RefineOptions& options) {
           {"move_wrist", options.move_wrist},
           {"move_fingers", options.move_fingers},
           {"prior", options.prior},
+          {"track", options.track},
+          {"track_within_deg", options.track_within_deg},
           {"render_side", options.render_side},
           {"blur_px", options.blur_px},
           {"object_unknown", options.object_unknown}};
@@ -158,7 +162,12 @@ cv::Mat Refiner::Silhouette(const Scene& scene, const cv::Matx23d& crop_from_sma
   return planes[0];
 }
 
-Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv::Matx23d& start_crop_from_image) {
+Eigen::Matrix3d RotationOf(const Refinement& refinement) {
+  return AxisAngle(Eigen::Vector3d::UnitZ(), -refinement.turn) * refinement.scene.hand.camera_from_hand;
+}
+
+Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv::Matx23d& start_crop_from_image,
+                           const Eigen::Matrix3d* previous) {
   NPHAND_THROW_CHECK(!target.image.empty() && target.image.type() == CV_32FC1 && target.image.rows == crop_.size &&
                          target.image.cols == crop_.size,
                      "refine: the target must be a ", crop_.size, " x ", crop_.size, " crop");
@@ -200,6 +209,15 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
     for (int i = 0; i < kPlace; ++i) squares += (p[i] - origin[i]) * (p[i] - origin[i]);
     return options_.prior * squares / kPlace / (0.25 * std::numbers::pi * std::numbers::pi);
   };
+  // The pull towards the previous frame's rotation, unless the lookup has moved far from it
+  // (a new view of the track, which the search's steps would not reach).
+  const bool track = previous != nullptr && options_.track > 0.0 &&
+                     RotationAngleDeg(start.hand.camera_from_hand, *previous) <= options_.track_within_deg;
+  auto pull = [&](const Parameters& p) {
+    if (!track) return 0.0;
+    const double angle = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), -p[kPlace + 3]) * scene.hand.camera_from_hand, *previous);
+    return options_.track * (angle / 90.0) * (angle / 90.0);
+  };
   auto evaluate = [&](const Parameters& p, double* disagreement) {
     pose(p);
     ++out.renders;
@@ -207,7 +225,7 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
     cv::Mat hand = Silhouette(scene, Compose(crop_from_image(p), image_from_small), &object);
     if (options_.blur_px > 0.0) cv::GaussianBlur(hand, hand, cv::Size(), options_.blur_px);
     *disagreement = Disagreement(hand, goal, options_.object_unknown ? &object : nullptr);
-    return *disagreement + prior(p);
+    return *disagreement + prior(p) + pull(p);
   };
   Parameters best = origin;
   double best_disagreement = 0.0;
