@@ -97,6 +97,7 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
                            {"frames", options.study.frames},
                            {"size", {options.study.width, options.study.height}},
                            {"seed", options.study.seed},
+                           {"input", options.study.masks ? "masks" : "rgb"},
                            {"rows", ToJson(scores)}};
     WriteFileAtomic(options.out_dir / (options.name + ".json"), json.dump(2) + "\n");
   }

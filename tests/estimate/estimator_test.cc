@@ -177,8 +177,11 @@ TEST_F(EstimatorTest, PlacementsKeptOrMadeAfreshAreTheSame) {
 }
 
 TEST_F(EstimatorTest, ALeftHandIsTheMirroredRightHand) {
+  for (bool refine : {false, true}) {
+  SCOPED_TRACE(refine ? "refined" : "looked up");
   const size_t e = EntryWithoutObject(*db_, 200);
   EstimatorOptions options = Options();
+  options.refine = refine;
   Estimator right(*db_, *index_, RightHand(), options);
   options.hand = Handedness::kLeft;
   Estimator left(*db_, *index_, RightHand(), options);
@@ -198,6 +201,7 @@ TEST_F(EstimatorTest, ALeftHandIsTheMirroredRightHand) {
   for (int j = 0; j < kNumKeypoints; ++j) {
     EXPECT_NEAR(l.keypoints_2d[j].x(), 160 - r.keypoints_2d[j].x(), 0.6);
     EXPECT_NEAR(l.keypoints_camera[j].x(), -r.keypoints_camera[j].x(), 1e-3);
+  }
   }
 }
 
@@ -462,6 +466,16 @@ TEST_F(EstimatorTest, RefinementBringsViewsBetweenTheDatabasesCloser) {
     }
   }
   ASSERT_GE(frames, 10);
+  // After a reset the same frames give the same estimates (nothing of the last track is kept).
+  refine.Reset();
+  Estimator fresh(*db_, *index_, RightHand(), refined);
+  for (int i = 0; i < sequence.size(); i += 2) {
+    const SequenceFrame frame = sequence.Render(i);
+    const cv::Mat mask = frame.labels == static_cast<int>(PixelLabel::kHand);
+    const FrameResult again = refine.ProcessMask(mask, frame.time_s), first = fresh.ProcessMask(mask, frame.time_s);
+    EXPECT_EQ(again.keypoints_2d, first.keypoints_2d) << i;
+    EXPECT_TRUE(again.pose.camera_from_hand == first.pose.camera_from_hand) << i;
+  }
   // Measured: wrist 13.3 -> 9.8 degrees, keypoints 24.6 -> 22.4 mm.
   EXPECT_LT(wrist[1], 0.85 * wrist[0]) << wrist[0] / frames << " -> " << wrist[1] / frames << " deg";
   EXPECT_LT(keypoints[1], 0.95 * keypoints[0]) << keypoints[0] / frames << " -> " << keypoints[1] / frames << " mm";

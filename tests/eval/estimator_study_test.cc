@@ -49,8 +49,8 @@ TEST_F(EstimatorStudyTest, EverySettingIsNamedOnceAndVariesWhatItSays) {
   EXPECT_EQ(find("refine-render128-sweeps6").options.refinement.render_side, 128);
 }
 
-// On the rendered masks (the paper's input) every frame whose hand is in view is detected,
-// and refinement is reported as part of a setting's options.
+// On the rendered masks (the paper's input) hands are found, and refinement is reported as
+// part of a setting's options.
 TEST_F(EstimatorStudyTest, MasksAreTheRenderedHandsOwn) {
   const ExactIndex index(DatabaseDescriptors(db()));
   EstimatorStudyOptions options = Small();
@@ -74,7 +74,6 @@ TEST_F(EstimatorStudyTest, RunsTheNamedSettingsOverTheSequences) {
     EXPECT_LE(s.detected, s.frames);
     EXPECT_LE(s.both_turns, s.detected);
     EXPECT_GE(s.keypoint_mm, 0.0);
-    EXPECT_GE(s.jitter_mm, 0.0);
   }
   EXPECT_EQ(scores[1].name, "turns0");
   EXPECT_EQ(scores[1].both_turns, 0) << "never the half turn";

@@ -75,6 +75,7 @@ void AddLookupTime(const FrameResult& other, FrameResult* kept) {
   kept->ms.describe += other.ms.describe;
   kept->ms.search += other.ms.search;
   kept->ms.weigh += other.ms.weigh;
+  kept->ms.refine += other.ms.refine;
 }
 
 }  // namespace
@@ -608,6 +609,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   const HandCrop& query_crop = crops[best.turn_of];
   // Refinement: the best entry's pose moved until its silhouette agrees with the query's;
   // it then stands for the entry in what follows.
+  const EntryPlacement& lookup_place = PlacementOf(best.entry);
   std::optional<EntryPlacement> refined;
   double turn = best.turn;  // the image-plane turn from the database's camera to the frame's
   if (refiner_.has_value()) {
@@ -618,7 +620,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
     if (refined_[side].frame != result.frame) refined_before_[side] = refined_[side];
     const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -best.turn) * refined_before_[side].rotation;
     const bool track = result.prior_used && refined_before_[side].frame == result.frame - 1;
-    const Refinement r = refiner_->Refine(query_crop, EntryScene(best.entry), PlacementOf(best.entry).crop_from_image,
+    const Refinement r = refiner_->Refine(query_crop, EntryScene(best.entry), lookup_place.crop_from_image,
                                           track ? &previous : nullptr);
     result.refined = r.moved;
     result.refine_objective = std::make_pair(r.objective_before, r.objective_after);
@@ -638,7 +640,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   // in its crop; the query's crop maps them into the frame, and the two crops' scales give
   // the distance.
   t = Clock::now();
-  const EntryPlacement& entry = refined.has_value() ? *refined : PlacementOf(best.entry);
+  const EntryPlacement& entry = refined.has_value() ? *refined : lookup_place;
   const cv::Matx23d frame_from_crop = Invert(query_crop.crop_from_image);
   const double size = options_.hand_length_m / model_hand_length_;
   const Intrinsics& camera = intrinsics_for(frame);

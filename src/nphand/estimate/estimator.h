@@ -141,7 +141,8 @@ struct FrameResult {
   double effective_samples = 0.0;              // 1 / sum w^2 over the hypotheses
   double confidence = 0.0;                     // the posterior mass near the estimate, 0..1
   // With refine: whether the refinement moved the pose, and its objective (silhouette
-  // disagreement, 1 - IoU, plus the pull towards the start) before and after.
+  // disagreement, 1 - IoU, plus the pulls towards the start and the last frame's rotation)
+  // before and after.
   bool refined = false;
   std::optional<std::pair<double, double>> refine_objective;
   StageMilliseconds ms;
@@ -188,7 +189,7 @@ class Estimator {
   RenderedImages RenderEntry(uint32_t entry);
 
  private:
-  // Everything after the hand's mask: describe, search, weigh, place. `hand_mask` is
+  // Everything after the hand's mask: describe, search, weigh, refine, place. `hand_mask` is
   // frame-sized, `box` its pixels' bounds; `result` comes with frame, time and segmentation
   // time filled in. A region unlike any view leaves the carried hypotheses as they were
   // (the caller may try another region, and forgets them if none is a hand).

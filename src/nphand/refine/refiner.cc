@@ -122,7 +122,7 @@ double Disagreement(const cv::Mat& a, const cv::Mat& b, const cv::Mat* unknown) 
       either += known * std::max(p[x], q[x]);
     }
   }
-  return either > 0.0 ? 1.0 - both / either : 0.0;
+  return either > 0.0 ? 1.0 - both / either : 1.0;
 }
 
 Refiner::Refiner(const HandModel& hand, const Intrinsics& camera, double distance_m, const CropOptions& crop,
@@ -174,7 +174,7 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
   const std::vector<Direction> directions = Directions(options_);
   // Both silhouettes blurred alike, so that the render's pixel steps and the target's
   // resampling matter less than the shapes.
-  cv::Mat goal;  // never a view of the target's pixels: the blur must not write into them
+  cv::Mat goal;  // blurred into its own pixels (a view of the target's would write into them), or the target's, unblurred
   if (options_.blur_px > 0.0) {
     cv::GaussianBlur(target.image, goal, cv::Size(), options_.blur_px);
   } else {
@@ -193,10 +193,14 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
     const cv::Matx23d place(c, s, centre - c * centre - s * centre + p[kPlace], -s, c, centre + s * centre - c * centre + p[kPlace + 1]);
     return Compose(place, start_crop_from_image);
   };
-  auto pose = [&](const Parameters& p) {
+  // The wrist's rotation of parameters `p`, in the render's camera.
+  auto wrist = [&](const Parameters& p) {
     Eigen::Matrix3d turn = Eigen::Matrix3d::Identity();
     for (int axis = 0; axis < kWristAxes; ++axis) turn = AxisAngle(Eigen::Vector3d::Unit(axis), p[axis]) * turn;
-    scene.hand.camera_from_hand = turn * start.hand.camera_from_hand;
+    return Eigen::Matrix3d(turn * start.hand.camera_from_hand);
+  };
+  auto pose = [&](const Parameters& p) {
+    scene.hand.camera_from_hand = wrist(p);
     for (int j = 0; j < kNumDofs; ++j) scene.hand.angles[j] = p[kWristAxes + j];
     scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, hand_model_.bind_centre(), distance_m_);
   };
@@ -215,7 +219,7 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
                      RotationAngleDeg(start.hand.camera_from_hand, *previous) <= options_.track_within_deg;
   auto pull = [&](const Parameters& p) {
     if (!track) return 0.0;
-    const double angle = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), -p[kPlace + 3]) * scene.hand.camera_from_hand, *previous);
+    const double angle = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), -p[kPlace + 3]) * wrist(p), *previous);
     return options_.track * (angle / 90.0) * (angle / 90.0);
   };
   auto evaluate = [&](const Parameters& p, double* disagreement) {
@@ -224,7 +228,7 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
     cv::Mat object;
     cv::Mat hand = Silhouette(scene, Compose(crop_from_image(p), image_from_small), &object);
     if (options_.blur_px > 0.0) cv::GaussianBlur(hand, hand, cv::Size(), options_.blur_px);
-    *disagreement = Disagreement(hand, goal, options_.object_unknown ? &object : nullptr);
+    *disagreement = Disagreement(hand, goal, options_.object_unknown && !start.objects.empty() ? &object : nullptr);
     return *disagreement + prior(p) + pull(p);
   };
   Parameters best = origin;

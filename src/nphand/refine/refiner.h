@@ -31,8 +31,9 @@ struct RefineOptions {
   // The fingers' joints: off by default, for the silhouette does not tell them well enough
   // (the validation sweep, docs/estimator.md: joint error 2.2 -> 3.9 degrees on masks).
   bool move_fingers = false;
-  // The pull towards the start: this weight times the mean square of the moved angles over
-  // 90 degrees, added to the disagreement (1 - IoU).
+  // The pull towards the start: this weight times the sum of the squared changes of the
+  // pose's angles (wrist and joints, radians) over their number (23), over (90 degrees)²,
+  // added to the disagreement (1 - IoU).
   double prior = 0.05;
   // The pull towards the previous frame's rotation (when given and within track_within_deg
   // of the start's): this weight times the square of the angle between them over 90 degrees.
@@ -51,14 +52,15 @@ nlohmann::json ToJson(const RefineOptions& options);
 
 // A silhouette agreement of two crop coverages (CV_32FC1 of one size): 1 - the
 // intersection over union (sum of minima over sum of maxima), in [0, 1] (0: the same).
-// Pixels count by 1 - `unknown` (if given: where an object may hide the hand, 1).
+// Pixels count by 1 - `unknown` (if given: where an object may hide the hand, 1). 1 when
+// nothing counts (no coverage on either side where it is known).
 double Disagreement(const cv::Mat& a, const cv::Mat& b, const cv::Mat* unknown = nullptr);
 
 struct Refinement {
   Scene scene;                       // the refined scene: the start's objects and distance
   cv::Matx23d crop_from_image;       // the camera's pixels to the target's crop, the place included
   double turn = 0.0;                 // radians the silhouette was turned in the crop (counter-clockwise as displayed)
-  double objective_before = 0.0;     // disagreement + prior at the start
+  double objective_before = 0.0;     // disagreement + the pulls, at the start
   double objective_after = 0.0;      // and at the end (never above the start's)
   double disagreement_before = 0.0;  // 1 - IoU at the start
   double disagreement_after = 0.0;
