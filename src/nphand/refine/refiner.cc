@@ -187,7 +187,8 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
   Refinement out;
   Scene scene = start;
   const double centre = 0.5 * (crop_.size - 1);
-  // The start's crop map moved by the place parameters: shifted and scaled about the crop's centre.
+  // The start's crop map moved by the place parameters: shifted, and scaled and turned about
+  // the crop's centre.
   auto crop_from_image = [&](const Parameters& p) {
     const double k = std::exp(p[kPlace + 2]), c = k * std::cos(p[kPlace + 3]), s = k * std::sin(p[kPlace + 3]);
     const cv::Matx23d place(c, s, centre - c * centre - s * centre + p[kPlace], -s, c, centre + s * centre - c * centre + p[kPlace + 1]);
@@ -206,8 +207,8 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
   };
   Parameters origin{};
   for (int j = 0; j < kNumDofs; ++j) origin[kWristAxes + j] = start.hand.angles[j];
-  // The pull towards the start's pose (not its place): the mean square of the moved angles
-  // over 90 degrees.
+  // The pull towards the start's pose (not its place): the mean square of the changes of
+  // its angles (wrist and joints), over (90 degrees)².
   auto prior = [&](const Parameters& p) {
     double squares = 0.0;
     for (int i = 0; i < kPlace; ++i) squares += (p[i] - origin[i]) * (p[i] - origin[i]);
