@@ -261,8 +261,9 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   const std::vector<RegionStats> stats = LabelRegions(out.skin, &out.labels);
   // What the set-aside shapes leave of a head or neck (the edge of a wider neck, a cheek):
   // regions lying almost wholly within a fifth of a face's width of them.
-  std::vector<int> near_face(stats.size(), 0);
+  std::vector<int> near_face;  // by label: its pixels in the zone (empty without faces)
   if (!faces_.empty()) {
+    near_face.assign(stats.size(), 0);
     cv::Mat zone = cv::Mat::zeros(work.size(), CV_8UC1);
     const cv::Rect bounds = draw_faces(0.2, &zone);
     for (int y = bounds.y; y < bounds.y + bounds.height; ++y) {
@@ -276,7 +277,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   for (size_t label = 1; label < stats.size(); ++label) {
     const RegionStats& found = stats[label];
     if (found.area < min_area) continue;
-    if (near_face[label] >= 0.8 * found.area) {
+    if (!near_face.empty() && near_face[label] >= 0.8 * found.area) {
       out.face_pixels += found.area * scale * scale;
       continue;
     }
