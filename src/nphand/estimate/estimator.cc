@@ -172,6 +172,10 @@ bool EstimatorOptions::Check(std::string* why) const {
   return false;
 }
 
+nlohmann::json RefinementJson(const EstimatorOptions& options) {
+  return options.refine ? ToJson(options.refinement) : nlohmann::json(false);
+}
+
 void SetHandChoice(const std::string& text, EstimatorOptions* options) {
   options->hand_auto = text == "auto";
   if (options->hand_auto) {

@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include "nphand/db/database.h"
@@ -90,6 +91,10 @@ struct EstimatorOptions {
   RefineOptions refinement;
   bool Check(std::string* why) const;
 };
+
+// The refinement's settings (refine/refiner.h's ToJson) when `options` refine, else false:
+// how reports say whether and how a run refined.
+nlohmann::json RefinementJson(const EstimatorOptions& options);
 
 // Sets `options`' hand from "right", "left" or "auto" (hand_auto, starting right); throws
 // nphand::Error for anything else.

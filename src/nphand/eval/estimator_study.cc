@@ -166,7 +166,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     score.options = {{"k", e.k},           {"observation", ToString(e.observation)}, {"sigma_y", e.sigma_y},
                      {"prior", ToString(e.prior)}, {"sigma_x", e.sigma_x}, {"prior_share", e.prior_share},
                      {"carried", e.carried},        {"roll_ambiguity", e.roll_ambiguity},
-                     {"refine", e.refine ? ToJson(e.refinement) : nlohmann::json(false)}};
+                     {"refine", RefinementJson(e)}};
     std::vector<double> ms;
     double jitter = 0.0;
     int jitter_count = 0;
