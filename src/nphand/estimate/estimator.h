@@ -23,8 +23,8 @@
 #include "nphand/model/hand_model.h"
 #include "nphand/render/camera.h"
 #include "nphand/render/renderer.h"
-#include "nphand/scene/grasp.h"
 #include "nphand/refine/refiner.h"
+#include "nphand/scene/grasp.h"
 #include "nphand/segment/forearm.h"
 #include "nphand/segment/skin.h"
 
