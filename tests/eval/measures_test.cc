@@ -74,6 +74,14 @@ TEST(MeasuresTest, JitterIsTheMeanSecondDifference) {
   EXPECT_NEAR(Jitter(steady), 0.0, 1e-12);
   EXPECT_NEAR(Jitter(accelerating), 0.001, 1e-12);
   EXPECT_EQ(Jitter(std::vector<Keypoints3d>(2, start)), 0.0);
+  // Runs weighted by their second differences: 8 steady and 2 of 0.001; a 2-frame run adds none.
+  RunJitter runs;
+  EXPECT_TRUE(runs.empty());
+  runs.Add(steady);
+  runs.Add(std::span(accelerating).first(4));
+  runs.Add(std::span(accelerating).first(2));
+  EXPECT_FALSE(runs.empty());
+  EXPECT_NEAR(runs.mean(), 0.002 / 10.0, 1e-12);
 }
 
 TEST(MeasuresTest, MedianIsTheUpperMiddleValue) {

@@ -168,15 +168,10 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
                      {"carried", e.carried},        {"roll_ambiguity", e.roll_ambiguity},
                      {"refine", RefinementJson(e)}};
     std::vector<double> ms;
-    double jitter = 0.0;
-    int jitter_count = 0;
+    RunJitter jitter;
     std::vector<Keypoints3d> run;  // the keypoints of the current run of detected frames
     auto close_run = [&]() {
-      if (run.size() >= 3) {
-        const int n = static_cast<int>(run.size()) - 2;
-        jitter += Jitter(run) * n;
-        jitter_count += n;
-      }
+      jitter.Add(run);
       run.clear();
     };
     for (const std::vector<SequenceFrame>& frames : sequences) {
@@ -214,7 +209,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
       }
     }
     close_run();
-    score.jitter_mm = jitter_count > 0 ? 1000.0 * jitter / jitter_count : 0.0;
+    score.jitter_mm = 1000.0 * jitter.mean();
     score.ms_median = Median(ms);
     scores.push_back(score);
     line.Update(scores.size());

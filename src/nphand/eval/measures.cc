@@ -82,4 +82,11 @@ double Jitter(std::span<const Keypoints3d> frames) {
   return sum / (static_cast<double>(frames.size() - 2) * kNumKeypoints);
 }
 
+void RunJitter::Add(std::span<const Keypoints3d> run) {
+  if (run.size() < 3) return;
+  const int n = static_cast<int>(run.size()) - 2;
+  sum_ += Jitter(run) * n;
+  count_ += n;
+}
+
 }  // namespace nphand

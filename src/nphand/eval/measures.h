@@ -40,4 +40,18 @@ double AreaUnderCurve(std::span<const double> distances, double max, int steps =
 // estimate's with its ground truth's own.
 double Jitter(std::span<const Keypoints3d> frames);
 
+// Jitter over several runs of consecutive frames (a track broken where the hand was lost):
+// each run's Jitter weighted by its second differences, so that the runs count as one
+// sequence of them. A run of fewer than 3 frames adds nothing.
+class RunJitter {
+ public:
+  void Add(std::span<const Keypoints3d> run);
+  bool empty() const { return count_ == 0; }
+  double mean() const { return count_ > 0 ? sum_ / count_ : 0.0; }  // metres per frame squared
+
+ private:
+  double sum_ = 0.0;
+  int count_ = 0;  // second differences
+};
+
 }  // namespace nphand

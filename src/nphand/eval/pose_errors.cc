@@ -142,21 +142,18 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
   summary.auc_0_50 = distances.empty() ? kNaN : AreaUnderCurve(distances, 0.05);
   summary.jitter_mm = summary.truth_jitter_mm = kNaN;
   // Jitter over each run of consecutive detected frames, weighted by its second differences.
-  double jitter = 0.0, truth_jitter = 0.0, weight = 0.0;
+  RunJitter jitter, truth_jitter;
   for (size_t begin = 0, end = 0; begin < detected_frames.size(); begin = end) {
     for (end = begin + 1; end < detected_frames.size() &&
                           int64_t{detected_frames[end]} == int64_t{detected_frames[end - 1]} + 1;) {
       ++end;
     }
-    if (end - begin < 3) continue;
-    const double n = static_cast<double>(end - begin - 2);
-    jitter += n * Jitter(std::span(estimated).subspan(begin, end - begin));
-    truth_jitter += n * Jitter(std::span(true_keypoints).subspan(begin, end - begin));
-    weight += n;
+    jitter.Add(std::span(estimated).subspan(begin, end - begin));
+    truth_jitter.Add(std::span(true_keypoints).subspan(begin, end - begin));
   }
-  if (weight > 0.0) {
-    summary.jitter_mm = 1000.0 * jitter / weight;
-    summary.truth_jitter_mm = 1000.0 * truth_jitter / weight;
+  if (!jitter.empty()) {
+    summary.jitter_mm = 1000.0 * jitter.mean();
+    summary.truth_jitter_mm = 1000.0 * truth_jitter.mean();
   }
   return summary;
 }

@@ -249,17 +249,12 @@ MethodScore Summarise(const std::string& method, const std::string& sequence, do
   std::vector<double> ms;
   double px = 0.0;
   int px_frames = 0;
-  double jitter = 0.0, truth_jitter = 0.0;
-  int jitter_count = 0;
+  RunJitter jitter, truth_jitter;
   for (const std::vector<FrameFigures>& frames : runs) {
     std::vector<Keypoints3d> run_estimate, run_truth;
     auto close_run = [&]() {
-      if (run_estimate.size() >= 3) {
-        const int n = static_cast<int>(run_estimate.size()) - 2;
-        jitter += Jitter(run_estimate) * n;
-        truth_jitter += Jitter(run_truth) * n;
-        jitter_count += n;
-      }
+      jitter.Add(run_estimate);
+      truth_jitter.Add(run_truth);
       run_estimate.clear();
       run_truth.clear();
     };
@@ -292,8 +287,8 @@ MethodScore Summarise(const std::string& method, const std::string& sequence, do
   s.keypoint_px = px_frames > 0 ? px / px_frames : kNaN;
   s.within_20mm = FractionWithin(s.distances, 0.020);
   s.auc_0_50 = AreaUnderCurve(s.distances, 0.050);
-  s.jitter_mm = jitter_count > 0 ? 1000.0 * jitter / jitter_count : kNaN;
-  s.truth_jitter_mm = jitter_count > 0 ? 1000.0 * truth_jitter / jitter_count : kNaN;
+  s.jitter_mm = jitter.empty() ? kNaN : 1000.0 * jitter.mean();
+  s.truth_jitter_mm = truth_jitter.empty() ? kNaN : 1000.0 * truth_jitter.mean();
   s.ms_median = Median(ms);
   for (const std::vector<bool>& found : no_hand) {
     s.no_hand_frames += static_cast<int>(found.size());
