@@ -20,6 +20,7 @@
 #include "apps/render_command.h"
 #include "apps/sequence_command.h"
 #include "nphand/util/check.h"
+#include "nphand/util/version.h"
 
 namespace {
 
@@ -522,6 +523,7 @@ int main(int argc, char** argv) {
   // nphand reports what went wrong itself; OpenCV's warnings (a failed video back end) are noise.
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   CLI::App app{"nphand: non-parametric hand pose estimation with object context"};
+  app.set_version_flag("--version", std::string("nphand ") + nphand::kVersion);
   app.require_subcommand(1);
   nphand::RenderCommandOptions render_options;
   nphand::BenchRenderOptions bench_options;

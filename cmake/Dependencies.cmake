@@ -9,22 +9,8 @@ find_package(ZLIB REQUIRED)          # CRC-32 of the database file
 find_package(OpenMP REQUIRED)        # FAISS's config names OpenMP::OpenMP_CXX
 find_package(faiss REQUIRED)         # exact search for the feature study; index backends
 
-# FLANN: exact k-d tree search (view-sphere coverage) and an index backend. Its pkg-config
-# file drags in HDF5; flann_cpp and lz4 are all it needs.
-find_path(FLANN_INCLUDE_DIR flann/flann.hpp REQUIRED)
-find_library(FLANN_CPP_LIBRARY flann_cpp REQUIRED)
-find_library(LZ4_LIBRARY lz4 REQUIRED)
-add_library(nphand_flann INTERFACE)
-target_include_directories(nphand_flann SYSTEM INTERFACE ${FLANN_INCLUDE_DIR})
-target_link_libraries(nphand_flann INTERFACE ${FLANN_CPP_LIBRARY} ${LZ4_LIBRARY})
-
-# tinygltf: Debian ships the compiled library; its header includes <stb_image.h> unqualified.
-find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h REQUIRED)
-find_library(TINYGLTF_LIBRARY tinygltf REQUIRED)
-find_path(STB_INCLUDE_DIR stb_image.h PATHS /usr/include/stb REQUIRED)
-add_library(nphand_tinygltf INTERFACE)
-target_include_directories(nphand_tinygltf SYSTEM INTERFACE ${TINYGLTF_INCLUDE_DIR} ${STB_INCLUDE_DIR})
-target_link_libraries(nphand_tinygltf INTERFACE ${TINYGLTF_LIBRARY})
+# FLANN (exact k-d tree search, an index backend) and tinygltf (the hand mesh).
+include(nphandThirdParty)
 
 if(NPHAND_BUILD_TESTS)
   find_package(GTest 1.12 REQUIRED)

@@ -1,6 +1,9 @@
 #include "nphand/model/hand_model.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <map>
 
 #include <Eigen/Geometry>
@@ -203,6 +206,37 @@ TEST(HandModelTest, MissingOrAlteredAssetGivesAClearError) {
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("sha256"), std::string::npos) << e.what();
+  }
+}
+
+// Found at run time, never from a path compiled in: the test binary lies in
+// <build>/tests/model, and <build>/share/nphand/hand links to the cache setup fills.
+TEST(HandModelTest, AssetIsFoundAboveTheRunningBinaryOrWhereTheEnvironmentSays) {
+  const char* env = std::getenv("NPHAND_ASSET_DIR");
+  const std::string saved = env != nullptr ? env : "";
+  unsetenv("NPHAND_ASSET_DIR");
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");
+  const std::filesystem::path build = self.parent_path().parent_path().parent_path();
+  const std::vector<std::filesystem::path> dirs = AssetSearchDirs();
+  ASSERT_FALSE(dirs.empty());
+  EXPECT_EQ(dirs.front(), self.parent_path() / "share/nphand/hand");
+  EXPECT_NE(std::find(dirs.begin(), dirs.end(), build / "share/nphand/hand"), dirs.end());
+  EXPECT_EQ(DefaultAssetDir(), build / "share/nphand/hand");
+  EXPECT_NO_THROW(HandModel::Load(Handedness::kLeft));
+
+  setenv("NPHAND_ASSET_DIR", "/nowhere/hand", 1);
+  EXPECT_EQ(DefaultAssetDir(), std::filesystem::path("/nowhere/hand"));
+  try {
+    HandModel::Load(Handedness::kRight);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nowhere/hand/right.glb: hand mesh not found"), std::string::npos)
+        << e.what();
+  }
+  if (saved.empty()) {
+    unsetenv("NPHAND_ASSET_DIR");
+  } else {
+    setenv("NPHAND_ASSET_DIR", saved.c_str(), 1);
   }
 }
 

@@ -1,8 +1,12 @@
 #include "nphand/model/hand_model.h"
 
+#include <dlfcn.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <system_error>
 
 #include <tiny_gltf.h>
 
@@ -64,9 +68,43 @@ bool IsThumb(int joint) { return joint >= 1 && joint <= 4; }
 
 }  // namespace
 
+std::vector<std::filesystem::path> AssetSearchDirs() {
+  // The file holding this code (the program, or a shared object such as the Python module)
+  // and the running program.
+  std::vector<std::filesystem::path> binaries;
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<void*>(&AssetSearchDirs), &info) != 0 && info.dli_fname != nullptr &&
+      info.dli_fname[0] == '/') {
+    binaries.emplace_back(info.dli_fname);
+  }
+  std::error_code error;
+  if (const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error); !error) {
+    binaries.push_back(self);
+  }
+  std::vector<std::filesystem::path> dirs;
+  const auto add = [&dirs](const std::filesystem::path& dir) {
+    if (std::find(dirs.begin(), dirs.end(), dir) == dirs.end()) dirs.push_back(dir);
+  };
+  for (const std::filesystem::path& binary : binaries) {
+    std::filesystem::path folder = binary.parent_path();
+    for (int level = 0; level < 5 && !folder.empty(); ++level) {
+      add(folder / "share" / "nphand" / "hand");
+      if (folder == folder.root_path()) break;
+      folder = folder.parent_path();
+    }
+  }
+  add(NPHAND_INSTALL_ASSET_DIR);
+  return dirs;
+}
+
 std::filesystem::path DefaultAssetDir() {
   if (const char* env = std::getenv("NPHAND_ASSET_DIR"); env != nullptr && *env != '\0') return env;
-  return NPHAND_DEFAULT_ASSET_DIR;
+  const std::vector<std::filesystem::path> dirs = AssetSearchDirs();
+  for (const std::filesystem::path& dir : dirs) {
+    std::error_code error;
+    if (std::filesystem::exists(dir / AssetFileName(Handedness::kRight), error)) return dir;
+  }
+  return dirs.empty() ? std::filesystem::path("share/nphand/hand") : dirs.front();
 }
 
 const char* PinnedAssetSha256(Handedness handedness) {
@@ -83,7 +121,8 @@ double HandLength(const Keypoints3d& k) {
 HandModel HandModel::Load(Handedness handedness, const std::filesystem::path& asset_dir) {
   const std::filesystem::path path = asset_dir / AssetFileName(handedness);
   NPHAND_THROW_CHECK(std::filesystem::exists(path), path.string(),
-                     ": hand mesh not found (run scripts/setup.sh, or set NPHAND_ASSET_DIR)");
+                     ": hand mesh not found (run scripts/setup.sh, install nphand, pass the asset folder or set "
+                     "NPHAND_ASSET_DIR)");
   const std::vector<uint8_t> bytes = ReadFileBytes(path);
   const std::string sha = Sha256Hex(bytes);
   NPHAND_THROW_CHECK(sha == PinnedAssetSha256(handedness), path.string(), ": sha256 ", sha,

@@ -21,9 +21,16 @@
 
 namespace nphand {
 
-// The folder holding right.glb and left.glb: $NPHAND_ASSET_DIR if set, else the cache that
-// scripts/setup.sh fills.
+// The folder holding right.glb and left.glb: $NPHAND_ASSET_DIR if set, else the first of
+// AssetSearchDirs() that holds right.glb, else the first of them (for the error message).
+// The build tree's share/nphand/hand links to the cache scripts/setup.sh fills; an install
+// puts the meshes in <prefix>/share/nphand/hand.
 std::filesystem::path DefaultAssetDir();
+// share/nphand/hand in the folder of the binary holding nphand's code (the program, or a
+// shared object such as the Python module), then in the folders above it (up to four
+// levels), then the same for the running program; last, the configured install prefix's
+// (for a program of one's own linked to an install in that prefix).
+std::vector<std::filesystem::path> AssetSearchDirs();
 // The pinned sha256 of the asset file of a hand (right.glb / left.glb of
 // @webxr-input-profiles/assets@1.0.20).
 const char* PinnedAssetSha256(Handedness handedness);
