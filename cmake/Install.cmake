@@ -7,6 +7,7 @@ include(CMakePackageConfigHelpers)
 # libraries are internal: nothing public includes them.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/nphand DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h"
+        PATTERN "model/gltf_accessor.h" EXCLUDE
         PATTERN "index/body.h" EXCLUDE
         PATTERN "index/index_file.h" EXCLUDE
         PATTERN "index/faiss_index.h" EXCLUDE

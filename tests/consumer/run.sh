@@ -15,7 +15,7 @@ if grep -n -e "-Werror" -e "-fsanitize" -e "-Wall" "$prefix"/lib/cmake/nphand/*.
   echo "consumer: the installed package carries the project's compile flags" >&2
   exit 1
 fi
-for internal in index/body.h index/index_file.h index/faiss_index.h index/flann_index.h index/hnswlib_index.h; do
+for internal in model/gltf_accessor.h index/body.h index/index_file.h index/faiss_index.h index/flann_index.h index/hnswlib_index.h; do
   if [ -e "$prefix/include/nphand/$internal" ]; then
     echo "consumer: internal header $internal was installed" >&2
     exit 1

@@ -63,6 +63,8 @@ class HandModel {
   const std::vector<Eigen::Vector3f>& bind_vertices() const { return bind_vertices_; }
   const std::vector<Eigen::Vector3f>& bind_normals() const { return bind_normals_; }
   const std::vector<Eigen::Vector3i>& triangles() const { return triangles_; }
+  // The asset's mesh coordinates into the hand frame (a rigid motion, fixed at load).
+  const Eigen::Isometry3d& hand_from_mesh() const { return hand_from_mesh_; }
   // Joint positions of the bind pose in the hand frame.
   const JointPositions& bind_joint_positions() const { return bind_positions_; }
   // The mean of the bind-pose joint positions: a point near the middle of the hand, for
@@ -98,6 +100,7 @@ class HandModel {
   std::vector<Eigen::Vector3i> triangles_;
   std::vector<std::array<uint8_t, 4>> skin_joints_;
   std::vector<Eigen::Vector4f> skin_weights_;
+  Eigen::Isometry3d hand_from_mesh_ = Eigen::Isometry3d::Identity();
   JointPositions bind_positions_;
   std::array<Eigen::Matrix3d, kNumJoints> bind_axes_;
   // Bind pose: each joint's frame relative to its parent's, and the inverse of its own.

@@ -1,0 +1,96 @@
+#include "nphand/motion/gltf_motion.h"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "nphand/util/check.h"
+#include "nphand/util/io.h"
+#include "testing/testing.h"
+
+namespace nphand {
+namespace {
+
+Motion RandomMotion(Handedness side, int frames, double scale, uint64_t seed) {
+  Random random(seed);
+  Motion motion;
+  motion.hand = side;
+  motion.fps = 25.0;
+  motion.scale = scale;
+  for (int f = 0; f < frames; ++f) {
+    MotionFrame frame;
+    frame.pose.handedness = side;
+    frame.pose.camera_from_hand = Eigen::Quaterniond(random.Normal(), random.Normal(), random.Normal(), random.Normal())
+                                      .normalized()
+                                      .toRotationMatrix();
+    frame.pose.angles = RandomArticulation(random);
+    frame.wrist_camera = Eigen::Vector3d(random.Uniform(-0.2, 0.2), random.Uniform(-0.2, 0.2), random.Uniform(0.3, 0.8));
+    motion.frames.push_back(frame);
+  }
+  return motion;
+}
+
+std::vector<uint8_t> AssetBytes(Handedness side) { return ReadFileBytes(DefaultAssetDir() / AssetFileName(side)); }
+
+TEST(GltfMotionTest, TheAnimatedHandLoadsBackWithItsJointsFramesAndKeypoints) {
+  for (const HandModel* hand : {&testing::RightHand(), &testing::LeftHand()}) {
+    for (double scale : {1.0, 0.9}) {
+      const Motion motion = RandomMotion(hand->handedness(), 30, scale, 11);
+      const auto path = testing::ScratchDir() / "hand.glb";
+      WriteGltfMotion(*hand, AssetBytes(hand->handedness()), motion, path);
+      const std::vector<uint8_t> bytes = ReadFileBytes(path);
+
+      // The project's own mesh reader takes it: the same rigged hand.
+      const HandModel loaded = HandModel::FromGlb(bytes, hand->handedness(), path.string());
+      EXPECT_EQ(loaded.bind_vertices().size(), hand->bind_vertices().size());
+
+      const GltfMotion read = ReadGltfMotion(bytes, path.string());
+      EXPECT_EQ(read.joints, kNumJoints);
+      ASSERT_EQ(read.frames.size(), motion.frames.size());
+      EXPECT_NEAR(read.fps, 25.0, 1e-3);
+      EXPECT_NE(read.copyright.find("MIT License"), std::string::npos);
+      double worst = 0.0;
+      for (size_t f = 0; f < motion.frames.size(); ++f) {
+        const Keypoints3d a = GltfKeypoints(read, f), b = MotionKeypoints(*hand, motion, f);
+        for (int k = 0; k < kNumKeypoints; ++k) worst = std::max(worst, (a[k] - b[k]).norm());
+      }
+      EXPECT_LT(worst, 1e-4) << ToString(hand->handedness()) << " scale " << scale << ": metres";
+    }
+  }
+}
+
+TEST(GltfMotionTest, TheSkinnedMeshFollowsTheJoints) {
+  // Skinning the written file's mesh the glTF way (node transforms times inverse bind
+  // matrices) puts the fingertip's vertices where the model's own skinning puts them.
+  const Motion motion = RandomMotion(Handedness::kRight, 1, 1.0, 3);
+  const std::vector<uint8_t> bytes = GltfMotionBytes(testing::RightHand(), AssetBytes(Handedness::kRight), motion);
+  const GltfMotion read = ReadGltfMotion(bytes, "hand.glb");
+  std::vector<Eigen::Vector3f> vertices;
+  testing::RightHand().Skin(motion.frames[0].pose, &vertices, nullptr);
+  const Keypoints3d keypoints = GltfKeypoints(read, 0);
+  // The closest skinned vertex to the index fingertip joint lies within a few millimetres.
+  const Eigen::Vector3d tip = keypoints[8] - motion.frames[0].wrist_camera;
+  double nearest = 1.0;
+  for (const Eigen::Vector3f& v : vertices) nearest = std::min(nearest, (v.cast<double>() - tip).norm());
+  EXPECT_LT(nearest, 0.01);
+}
+
+TEST(GltfMotionTest, WrongInputsAreRefusedByName) {
+  const Motion motion = RandomMotion(Handedness::kLeft, 2, 1.0, 1);
+  EXPECT_THROW(GltfMotionBytes(testing::RightHand(), AssetBytes(Handedness::kRight), motion), Error);
+  const std::vector<uint8_t> garbage(100, 3);
+  try {
+    ReadGltfMotion(garbage, "garbage.glb");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("garbage.glb: not a readable binary glTF"), std::string::npos) << e.what();
+  }
+  try {
+    ReadGltfMotion(AssetBytes(Handedness::kRight), "right.glb");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("right.glb: no animation"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace nphand
