@@ -14,9 +14,13 @@
 #include "apps/video_file.h"
 #include "nphand/estimate/frame_json.h"
 #include "nphand/index/backends.h"
+#include "nphand/motion/bvh.h"
+#include "nphand/motion/gltf_motion.h"
+#include "nphand/motion/motion.h"
 #include "nphand/render/draw.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
+#include "nphand/util/io.h"
 #include "nphand/util/progress.h"
 #include "nphand/util/text.h"
 
@@ -78,6 +82,42 @@ std::vector<NamedPath> Inputs(const EstimateCommandOptions& options, const std::
   return inputs;
 }
 
+// The motion files of a run: one track per side, the side with more frames written.
+class MotionOutputs {
+ public:
+  MotionOutputs(const EstimateCommandOptions& options, double fps, double scale)
+      : options_(options), right_(Handedness::kRight, fps, scale), left_(Handedness::kLeft, fps, scale) {}
+  bool wanted() const { return !options_.bvh.empty() || !options_.gltf.empty(); }
+
+  void Add(const FrameResult* result) {
+    std::optional<MotionFrame> frame;
+    if (result != nullptr && result->detected()) frame = MotionFrame{result->pose, result->keypoints_camera[0]};
+    right_.Add(frame);
+    left_.Add(frame);
+  }
+
+  // Writes the files (atomically); throws nphand::Error when no frame had a hand.
+  void Write(nlohmann::json* summary) const {
+    const MotionRecorder& track = left_.with_hand() > right_.with_hand() ? left_ : right_;
+    const Motion motion = track.Finish();
+    const HandModel hand = HandModel::Load(motion.hand, options_.asset_dir);
+    if (!options_.bvh.empty()) {
+      WriteBvh(hand, motion, options_.bvh);
+      (*summary)["bvh"] = Utf8OrEscaped(options_.bvh.string());
+    }
+    if (!options_.gltf.empty()) {
+      WriteGltfMotion(hand, ReadFileBytes(options_.asset_dir / AssetFileName(motion.hand)), motion, options_.gltf);
+      (*summary)["gltf"] = Utf8OrEscaped(options_.gltf.string());
+    }
+    (*summary)["motion"] = {{"hand", ToString(motion.hand)}, {"frames", motion.frames.size()},
+                            {"with_hand", track.with_hand()}, {"scale", motion.scale}};
+  }
+
+ private:
+  const EstimateCommandOptions& options_;
+  MotionRecorder right_, left_;
+};
+
 }  // namespace
 
 const char* SignalName(int signal) {
@@ -99,10 +139,14 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   NPHAND_THROW_CHECK(estimator_options.Check(&why), "estimate: ", why);
   CheckOutputFile(options.out, "--out");
   if (!options.overlay.empty()) CheckOutputFile(options.overlay, "--overlay");
+  if (!options.bvh.empty()) CheckOutputFile(options.bvh, "--bvh");
+  if (!options.gltf.empty()) CheckOutputFile(options.gltf, "--gltf");
   const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
   FrameSource source(options.input, options.fps);
   std::vector<NamedPath> outputs = {{options.out, "--out"}};
   if (!options.overlay.empty()) outputs.push_back({options.overlay, "--overlay"});
+  if (!options.bvh.empty()) outputs.push_back({options.bvh, "--bvh"});
+  if (!options.gltf.empty()) outputs.push_back({options.gltf, "--gltf"});
   // A clash first: it is the graver mistake, and names the file at stake.
   CheckOutputsApart(Inputs(options, index_path, source), outputs);
   std::error_code error;
@@ -114,6 +158,10 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
     NPHAND_THROW_CHECK(AsciiLower(options.overlay.extension().string()) == ".mp4", "--overlay '", options.overlay.string(),
                        "': nphand writes the overlay as MPEG-4; name it .mp4");
   }
+  NPHAND_THROW_CHECK(options.bvh.empty() || AsciiLower(options.bvh.extension().string()) == ".bvh", "--bvh '",
+                     options.bvh.string(), "': name the motion file .bvh");
+  NPHAND_THROW_CHECK(options.gltf.empty() || AsciiLower(options.gltf.extension().string()) == ".glb", "--gltf '",
+                     options.gltf.string(), "': nphand writes binary glTF; name it .glb");
 
   // The outputs are taken (locked) before the long load, so that a second run into them is
   // refused at once; their final names are replaced only when the run has frames to show.
@@ -125,6 +173,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
   const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
   Estimator estimator(db, *index, hand, estimator_options);
+  MotionOutputs motion(options, source.fps(), estimator_options.hand_length_m / ModelHandLength(db));
 
   const uint64_t total = options.max_frames > 0 && source.count() > 0 ? std::min(options.max_frames, source.count())
                          : options.max_frames > 0                      ? options.max_frames
@@ -149,6 +198,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
         json = {{"frame", frames}, {"time_s", frame->time_s}, {"detected", false}, {"status", "unreadable"},
                 {"reason", frame->error}};
         ++unreadable;
+        motion.Add(nullptr);
         if (overlay.has_value() && overlay->frames() > 0) {
           overlay->Write(UnreadablePicture(overlay->size(), frame->error));
         } else if (overlay.has_value()) {
@@ -160,6 +210,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
         json["frame"] = frames;  // the input's numbering, unreadable frames included
         detected += result.detected();
         estimate_ms += result.ms.total;
+        motion.Add(&result);
         if (overlay.has_value()) {
           const cv::Mat picture = Overlay(frame->bgr, result, &estimator, db);
           overlay->Size(picture.size());
@@ -191,6 +242,14 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
                 lines.partial().string() + ")");
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  nlohmann::json motion_files = nlohmann::json::object();
+  if (frames > 0 && motion.wanted()) {
+    try {
+      motion.Write(&motion_files);
+    } catch (const Error& e) {
+      throw Error(std::string(e.what()) + " (the poses are complete in " + options.out.string() + ")");
+    }
+  }
   nlohmann::json summary = {{"input", Utf8OrEscaped(options.input)},
                             {"input_kind", source.kind()},
                             {"frames", frames},
@@ -212,6 +271,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   if (frames > 0) {
     summary["out"] = Utf8OrEscaped(options.out.string());
     if (overlay.has_value() && overlay->frames() > 0) summary["overlay"] = Utf8OrEscaped(options.overlay.string());
+    summary.update(motion_files);
   } else {
     summary["out"] = nullptr;
   }

@@ -21,6 +21,8 @@ struct EstimateCommandOptions {
   std::string input;                      // video file, image folder or camera index
   std::filesystem::path out = "out/poses.jsonl";
   std::filesystem::path overlay;          // optional .mp4: the frame with the skeleton, the matched view beside it
+  std::filesystem::path bvh;              // optional .bvh: the skeleton's motion (nphand/motion/bvh.h)
+  std::filesystem::path gltf;             // optional .glb: the rigged mesh with the motion (nphand/motion/gltf_motion.h)
   std::string hand = "right";
   std::string observation = "fixed";
   std::string prior = "product";
@@ -32,7 +34,10 @@ struct EstimateCommandOptions {
   std::filesystem::path asset_dir = DefaultAssetDir();
 };
 
-// Runs the estimator over the input (docs/FORMAT.md says what each ending leaves). Before any
+// Runs the estimator over the input (docs/FORMAT.md says what each ending leaves). The motion
+// files hold one track of the hand's side (with --hand auto, the side found in more frames);
+// frames without it hold the last pose. They are written after the poses, and a run
+// without any hand writes none of them and says so. Before any
 // work, an output that is an input or another output is refused, and so is a second run
 // into the same outputs. `stop` (if not null) is polled between frames: when it holds a
 // signal number the run ends cleanly after the current frame. Returns a summary (frames,

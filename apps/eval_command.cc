@@ -74,6 +74,11 @@ PoseErrorSummary RunEvalPoses(const EvalPosesCommandOptions& options) {
   return summary;
 }
 
+MotionCheck RunEvalMotion(const EvalMotionCommandOptions& options) {
+  NPHAND_THROW_CHECK(!options.bvh.empty() || !options.gltf.empty(), "eval motion: give --bvh, --gltf or both");
+  return CheckMotion(options.poses, options.bvh, options.gltf);
+}
+
 std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& options) {
   std::string why;
   NPHAND_THROW_CHECK(options.study.Check(&why), "eval estimator: ", why);

@@ -5,6 +5,7 @@
 
 #include "nphand/eval/ann_study.h"
 #include "nphand/eval/estimator_study.h"
+#include "nphand/eval/motion_check.h"
 #include "nphand/eval/pose_errors.h"
 #include "nphand/eval/pose_study.h"
 #include "nphand/eval/feature_study.h"
@@ -50,6 +51,15 @@ struct EvalPosesCommandOptions {
 
 // Errors of estimated poses against ground truth (docs/FORMAT.md), frame by frame.
 PoseErrorSummary RunEvalPoses(const EvalPosesCommandOptions& options);
+
+struct EvalMotionCommandOptions {
+  std::filesystem::path poses;  // poses.jsonl of `nphand estimate`
+  std::filesystem::path bvh;    // its --bvh, its --gltf: at least one
+  std::filesystem::path gltf;
+};
+
+// The motion files read back against the poses (nphand/eval/motion_check.h).
+MotionCheck RunEvalMotion(const EvalMotionCommandOptions& options);
 
 struct EvalPoseStudyCommandOptions {
   std::filesystem::path db = "out/nphand.db";

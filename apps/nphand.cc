@@ -151,6 +151,8 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--input", o.input, "Video file, image folder (name order) or camera index")->required();
   cmd->add_option("--out", o.out, "JSON lines, one object per frame (docs/FORMAT.md)")->capture_default_str();
   cmd->add_option("--overlay", o.overlay, "Overlay video (.mp4): the skeleton, and the matched database view beside it");
+  cmd->add_option("--bvh", o.bvh, "Motion as BVH (.bvh): the hand's skeleton, wrist place and joint angles per frame");
+  cmd->add_option("--gltf", o.gltf, "Motion as binary glTF (.glb): the rigged hand mesh with the estimated animation");
   cmd->add_option("--hand", o.hand,
                   "right, left (mirrored into the right-hand database) or auto (both searched; the better side kept for the track)")
       ->capture_default_str();
@@ -394,6 +396,19 @@ void AddEvalPosesCommand(CLI::App* eval, nphand::EvalPosesCommandOptions& o, boo
   });
 }
 
+void AddEvalMotionCommand(CLI::App* eval, nphand::EvalMotionCommandOptions& o, bool& json) {
+  CLI::App* cmd = eval->add_subcommand(
+      "motion", "Motion files (estimate --bvh, --gltf) read back: their keypoints against the estimate's (poses.jsonl)");
+  cmd->add_option("--poses", o.poses, "poses.jsonl of nphand estimate")->required();
+  cmd->add_option("--bvh", o.bvh, "The run's .bvh");
+  cmd->add_option("--gltf", o.gltf, "The run's .glb");
+  cmd->add_flag("--json", json, "Print JSON instead of the table");
+  cmd->callback([&o, &json]() {
+    const nphand::MotionCheck check = nphand::RunEvalMotion(o);
+    std::cout << (json ? Dump(nphand::ToJson(check)) + "\n" : nphand::FormatTable(check));
+  });
+}
+
 void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool& json) {
   CLI::App* cmd = eval->add_subcommand(
       "real", "The estimator on labelled real images and video (real-dev's labels.jsonl), scored as real-dev's reference does");
@@ -465,10 +480,12 @@ void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOption
 
 void AddEvalCommand(CLI::App& app, nphand::EvalFeaturesCommandOptions& o, nphand::EvalAnnCommandOptions& ann,
                     nphand::EvalEstimatorCommandOptions& estimator, nphand::EvalPosesCommandOptions& poses,
-                    nphand::EvalPoseStudyCommandOptions& study, nphand::EvalRealCommandOptions& real, bool& json) {
+                    nphand::EvalPoseStudyCommandOptions& study, nphand::EvalRealCommandOptions& real,
+                    nphand::EvalMotionCommandOptions& motion, bool& json) {
   CLI::App* eval = app.add_subcommand("eval", "The paper's experiments, and nphand on real images");
   eval->require_subcommand(1);
   AddEvalPosesCommand(eval, poses, json);
+  AddEvalMotionCommand(eval, motion, json);
   AddEvalRealCommand(eval, real, json);
   AddEvalAnnCommand(eval, ann, json);
   AddEvalEstimatorCommand(eval, estimator, json);
@@ -545,8 +562,9 @@ int main(int argc, char** argv) {
   nphand::EvalPosesCommandOptions poses_options;
   nphand::EvalPoseStudyCommandOptions pose_study_options;
   nphand::EvalRealCommandOptions real_options;
+  nphand::EvalMotionCommandOptions motion_options;
   AddEvalCommand(app, eval_options, ann_options, estimator_study_options, poses_options, pose_study_options, real_options,
-                 json);
+                 motion_options, json);
   try {
     CheckSubcommands(app, argc, argv);
     app.parse(argc, argv);

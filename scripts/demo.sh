@@ -57,7 +57,9 @@ seq="$out/sequence"
 hand_length=$(sed -n 's/.*"hand_length_m": \([0-9.]*\).*/\1/p' "$seq/sequence.json")
 echo "demo: estimating its poses"
 "$nphand" estimate --db "$root/out/nphand.db" --input "$seq/frames" --hand-length "$hand_length" \
-  --out "$out/poses.jsonl" --overlay "$out/overlay.mp4"
+  --out "$out/poses.jsonl" --overlay "$out/overlay.mp4" --bvh "$out/motion.bvh" --gltf "$out/motion.glb"
+echo "demo: the motion files read back against the poses"
+"$nphand" eval motion --poses "$out/poses.jsonl" --bvh "$out/motion.bvh" --gltf "$out/motion.glb"
 echo "demo: errors against the ground truth"
 "$nphand" eval poses --truth "$seq/truth.jsonl" --poses "$out/poses.jsonl" --out "$out" --name errors
 realdev="$root/../shared/real-dev"
@@ -70,5 +72,6 @@ fi
 echo "demo: done; images in $out"
 echo "  poses:   $out/poses.jsonl (docs/FORMAT.md)"
 echo "  overlay: $out/overlay.mp4"
+echo "  motion:  $out/motion.bvh, $out/motion.glb (the rigged hand, animated)"
 echo "  errors:  $out/errors.png, $out/errors.json"
 if [ -f "$realdev/labels.jsonl" ]; then echo "  real:    $out/real.json, $out/real_contact.png"; fi

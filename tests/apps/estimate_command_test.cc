@@ -5,6 +5,7 @@
 #include <atomic>
 #include <csignal>
 #include <fstream>
+#include <iostream>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include "apps/eval_command.h"
 #include "apps/index_command.h"
 #include "apps/sequence_command.h"
+#include "nphand/db/database.h"
 #include "nphand/util/check.h"
 #include "testing/testing.h"
 #include "tests/apps/command_fixture.h"
@@ -173,6 +175,65 @@ TEST_F(EstimateCommandTest, BadInputsGiveTheirErrors) {
   eval.truth = *dir_ / "sequence" / "truth.jsonl";
   eval.poses = *dir_ / "broken.jsonl";
   testing::ExpectError([&] { RunEvalPoses(eval); }, "has no valid 'joint_angles_deg'");
+}
+
+TEST_F(EstimateCommandTest, MotionFilesHoldTheEstimatesKeypointsAndNeedAHand) {
+  EstimateCommandOptions options = Options();
+  options.bvh = *dir_ / "motion.bvh";
+  options.gltf = *dir_ / "motion.glb";
+  const nlohmann::json summary = RunEstimate(options, nullptr, nullptr);
+  ASSERT_GT(summary["detected"].get<int>(), 0);
+  EXPECT_EQ(summary["bvh"], options.bvh.string());
+  EXPECT_EQ(summary["gltf"], options.gltf.string());
+  EXPECT_EQ(summary["motion"]["frames"], 5);
+  EXPECT_EQ(summary["motion"]["with_hand"], summary["detected"]);
+  EXPECT_EQ(summary["motion"]["hand"], "right");
+
+  // Read back (the BVH through forward kinematics), they give the estimate's keypoints.
+  EvalMotionCommandOptions check;
+  check.poses = options.out;
+  check.bvh = options.bvh;
+  check.gltf = options.gltf;
+  const MotionCheck result = RunEvalMotion(check);
+  EXPECT_EQ(result.frames, 5u);
+  EXPECT_EQ(result.compared, summary["detected"].get<size_t>());
+  ASSERT_TRUE(result.bvh.has_value() && result.gltf.has_value());
+  EXPECT_LT(result.bvh->max_mm, 1.0);
+  EXPECT_LT(result.gltf->max_mm, 1.0);
+  std::cout << FormatTable(result);
+
+  // Wrong names, and outputs that are inputs, are refused before any work.
+  options = Options();
+  options.bvh = *dir_ / "motion.txt";
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "name the motion file .bvh");
+  options = Options();
+  options.gltf = *dir_ / "motion.gltf";
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "nphand writes binary glTF; name it .glb");
+  options = Options();
+  options.gltf = options.db;
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "--gltf");
+  EXPECT_NO_THROW(Database::Open(options.db));
+  check.bvh.clear();
+  check.gltf.clear();
+  testing::ExpectError([&] { RunEvalMotion(check); }, "give --bvh, --gltf or both");
+
+  // Frames without any hand: the poses are written, the motion files are not, and the error
+  // says why.
+  const std::filesystem::path dark = *dir_ / "dark";
+  std::filesystem::create_directories(dark);
+  for (const char* name : {"000000.png", "000001.png"}) {
+    std::filesystem::copy_file(*dir_ / "sequence" / "labels" / "000000.png", dark / name,
+                               std::filesystem::copy_options::overwrite_existing);
+  }
+  options = Options();
+  options.input = dark.string();
+  options.out = *dir_ / "dark.jsonl";
+  options.bvh = *dir_ / "dark.bvh";
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); },
+                       "none of the 2 frames had a right hand, so there is no motion to write");
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "(the poses are complete in");
+  EXPECT_EQ(Lines(options.out).size(), 2u);
+  EXPECT_FALSE(std::filesystem::exists(options.bvh));
 }
 
 // `nphand eval real` end to end, on labels in real-dev's format made from the rendered
