@@ -10,7 +10,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libopencv-dev opencv-data libeigen3-dev libtinygltf-dev libstb-dev
   libfaiss-dev libhnswlib-dev libflann-dev liblz4-dev
-  nlohmann-json3-dev libcli11-dev pybind11-dev
+  nlohmann-json3-dev libcli11-dev pybind11-dev python3-dev python3-numpy python3-pytest
   libgtest-dev libgmock-dev libbenchmark-dev
   libssl-dev zlib1g-dev libopenblas0-pthread nodejs
 )
