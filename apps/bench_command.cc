@@ -71,15 +71,15 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
     int threads;
     ~Restore() { cv::setNumThreads(threads); }
   } restore{opencv_threads};
-  const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
-  const Database db = Database::Open(options.db);
-  const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
-  const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
+  const OpenedFiles files(options);
+  const Database& db = files.db;
+  const KnnIndex& index = *files.index;
+  const HandModel& hand = files.hand;
   EstimatorOptions estimator_options;
   estimator_options.k = options.k;
   SetHandChoice(options.hand, &estimator_options);
   estimator_options.refine = options.refine;
-  Estimator estimator(db, *index, hand, estimator_options);
+  Estimator estimator(db, index, hand, estimator_options);
   const double rss_loaded = PeakRssMb();
 
   // Frames come from rendered sequences, one at a time (rendering is not timed).
@@ -122,8 +122,8 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
       {"height", options.height},
       {"db_entries", db.size()},
       {"db_file_mb", db.file_bytes() / 1e6},
-      {"backend", index->Backend()},
-      {"index_mb", index->MemoryBytes() / 1e6},
+      {"backend", index.Backend()},
+      {"index_mb", index.MemoryBytes() / 1e6},
       {"k", options.k},
       {"refine", options.refine},
       {"hand", options.hand},

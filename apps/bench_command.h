@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/estimator_files.h"
 #include "nphand/model/hand_model.h"
 
 namespace nphand {
@@ -29,9 +30,7 @@ nlohmann::json RunBenchRender(const BenchRenderOptions& options);
 // `nphand bench pipeline`: frames per second of the whole estimator on one core: skin
 // segmentation of the frame, the forearm cut, the descriptor, the K-nearest search, the
 // weights and prior, the placement; milliseconds per stage; peak resident memory.
-struct BenchPipelineOptions {
-  std::filesystem::path db = "out/nphand.db";
-  std::filesystem::path index;  // default: the database's path + ".idx"
+struct BenchPipelineOptions : EstimatorFiles {
   int frames = 300;             // timed (after a warm-up of 30), from rendered sequences
   int width = 640;
   int height = 480;
@@ -42,7 +41,6 @@ struct BenchPipelineOptions {
   // OpenCV's threads for the image work (colour, resizing, morphology, the face cascade);
   // 1 keeps the whole path on one core, as the speed goal asks.
   int threads = 1;
-  std::filesystem::path asset_dir = DefaultAssetDir();
 
   bool Check(std::string* why) const;
 };

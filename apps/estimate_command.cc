@@ -70,12 +70,10 @@ cv::Mat UnreadablePicture(cv::Size size, const std::string& reason) {
 }
 
 // Every file a run reads: refused as an output.
-std::vector<NamedPath> Inputs(const EstimateCommandOptions& options, const std::filesystem::path& index_path,
-                              const FrameSource& source) {
-  std::vector<NamedPath> inputs = {{options.db, "--db"},
-                                   {index_path, "--index"},
-                                   {options.asset_dir / "right.glb", "the hand asset"},
-                                   {options.asset_dir / "left.glb", "the hand asset"}};
+std::vector<NamedPath> Inputs(const EstimateCommandOptions& options, const FrameSource& source) {
+  std::vector<NamedPath> inputs = options.Inputs();
+  inputs.push_back({options.asset_dir / "right.glb", "the hand asset"});
+  inputs.push_back({options.asset_dir / "left.glb", "the hand asset"});
   if (source.kind() == "video") inputs.push_back({options.input, "--input"});
   for (const std::filesystem::path& image : source.images()) inputs.push_back({image, "an image of --input"});
   if (options.faces) inputs.push_back({options.estimator.skin.face_cascade, "the face cascade"});
@@ -141,19 +139,14 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   if (!options.overlay.empty()) CheckOutputFile(options.overlay, "--overlay");
   if (!options.bvh.empty()) CheckOutputFile(options.bvh, "--bvh");
   if (!options.gltf.empty()) CheckOutputFile(options.gltf, "--gltf");
-  const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
   FrameSource source(options.input, options.fps);
   std::vector<NamedPath> outputs = {{options.out, "--out"}};
   if (!options.overlay.empty()) outputs.push_back({options.overlay, "--overlay"});
   if (!options.bvh.empty()) outputs.push_back({options.bvh, "--bvh"});
   if (!options.gltf.empty()) outputs.push_back({options.gltf, "--gltf"});
   // A clash first: it is the graver mistake, and names the file at stake.
-  CheckOutputsApart(Inputs(options, index_path, source), outputs);
-  std::error_code error;
-  NPHAND_THROW_CHECK(std::filesystem::exists(options.db, error), options.db.string(),
-                     ": no database there (make one with `nphand db build`)");
-  NPHAND_THROW_CHECK(std::filesystem::exists(index_path, error), index_path.string(),
-                     ": no index there (make one with `nphand index build --db ", options.db.string(), "`)");
+  CheckOutputsApart(Inputs(options, source), outputs);
+  options.CheckPresent();
   if (!options.overlay.empty()) {
     NPHAND_THROW_CHECK(AsciiLower(options.overlay.extension().string()) == ".mp4", "--overlay '", options.overlay.string(),
                        "': nphand writes the overlay as MPEG-4; name it .mp4");
@@ -169,10 +162,9 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   std::optional<VideoFile> overlay;
   if (!options.overlay.empty()) overlay.emplace(options.overlay, source.fps());
 
-  const Database db = Database::Open(options.db);
-  const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
-  const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
-  Estimator estimator(db, *index, hand, estimator_options);
+  const OpenedFiles files(options);
+  const Database& db = files.db;
+  Estimator estimator(db, *files.index, files.hand, estimator_options);
   MotionOutputs motion(options, source.fps(), estimator_options.hand_length_m / ModelHandLength(db));
 
   const uint64_t total = options.max_frames > 0 && source.count() > 0 ? std::min(options.max_frames, source.count())

@@ -10,14 +10,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/estimator_files.h"
 #include "nphand/estimate/estimator.h"
 #include "nphand/model/hand_model.h"
 
 namespace nphand {
 
-struct EstimateCommandOptions {
-  std::filesystem::path db = "out/nphand.db";
-  std::filesystem::path index;            // default: the database's path + ".idx"
+struct EstimateCommandOptions : EstimatorFiles {
   std::string input;                      // video file, image folder or camera index
   std::filesystem::path out = "out/poses.jsonl";
   std::filesystem::path overlay;          // optional .mp4: the frame with the skeleton, the matched view beside it
@@ -31,7 +30,6 @@ struct EstimateCommandOptions {
   bool top = false;                       // write the top-N hypotheses
   bool faces = true;                      // set faces aside (OpenCV's cascade from opencv-data)
   EstimatorOptions estimator;
-  std::filesystem::path asset_dir = DefaultAssetDir();
 };
 
 // Runs the estimator over the input (docs/FORMAT.md says what each ending leaves). The motion

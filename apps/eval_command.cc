@@ -86,18 +86,16 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
     CheckFileName(options.name, "eval estimator --name");
     CheckOutputFolder(options.out_dir, "eval estimator --out");
   }
-  const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
   if (!options.out_dir.empty()) {
-    CheckOutputsApart({{options.db, "--db"}, {index_path, "--index"}}, NamedOutputs(options.out_dir, options.name, {".json"}));
+    CheckOutputsApart(options.Inputs(), NamedOutputs(options.out_dir, options.name, {".json"}));
   }
-  const Database db = Database::Open(options.db);
-  const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
-  const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
-  const std::vector<EstimatorScore> scores = RunEstimatorStudy(db, *index, hand, EstimatorOptions{}, options.study, &std::cerr);
+  const OpenedFiles files(options);
+  const std::vector<EstimatorScore> scores =
+      RunEstimatorStudy(files.db, *files.index, files.hand, EstimatorOptions{}, options.study, &std::cerr);
   if (!options.out_dir.empty()) {
     nlohmann::json json = {{"study", "estimator validation sweep"},
                            {"database", options.db.filename().string()},
-                           {"index", index->Backend()},
+                           {"index", files.index->Backend()},
                            {"sequences", options.study.sequences},
                            {"frames", options.study.frames},
                            {"size", {options.study.width, options.study.height}},
@@ -112,36 +110,37 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
 EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* progress) {
   NPHAND_THROW_CHECK(!options.labels.empty(), "eval real: --labels is required (e.g. ../shared/real-dev/labels.jsonl)");
   NPHAND_THROW_CHECK(options.hand == "given" || options.hand == "auto", "eval real: --hand is given or auto, not '", options.hand, "'");
-  const std::filesystem::path index_path = IndexPathOf(options.db, options.index);
   if (!options.out_dir.empty()) {
     CheckOutputFolder(options.out_dir, "eval real --out");
-    CheckOutputsApart({{options.labels, "--labels"}, {options.db, "--db"}, {index_path, "--index"}},
-                      {{options.out_dir, "eval real --out", {".json", ".jsonl", ".png"}}});
+    std::vector<NamedPath> inputs = options.Inputs();
+    inputs.insert(inputs.begin(), {options.labels, "--labels"});
+    CheckOutputsApart(inputs, {{options.out_dir, "eval real --out", {".json", ".jsonl", ".png"}}});
   }
   const std::vector<RealLabel> labels = ReadRealLabels(options.labels);
   const std::filesystem::path root = options.labels.has_parent_path() ? options.labels.parent_path() : ".";
   CheckRealFiles(labels, root);
-  const Database db = Database::Open(options.db);
-  const std::unique_ptr<KnnIndex> index = LoadIndex(index_path, db);
-  const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
+  const OpenedFiles files(options);
+  const Database& db = files.db;
+  const KnnIndex& index = *files.index;
+  const HandModel& hand = files.hand;
   EstimatorOptions estimator_options;
   if (!options.faces) estimator_options.skin.face_cascade.clear();
   estimator_options.refine = options.refine;
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
-  Estimator right(db, *index, hand, estimator_options);
+  Estimator right(db, index, hand, estimator_options);
   // With the side given, a second estimator for the left hands.
   std::optional<Estimator> left;
   if (given) {
     estimator_options.hand = Handedness::kLeft;
-    left.emplace(db, *index, hand, estimator_options);
+    left.emplace(db, index, hand, estimator_options);
   }
   const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, left ? &*left : nullptr, progress);
   const RealScore score = ScoreReal(labels, predictions);
   EvalRealResult result{ToJson(score), FormatTable(score)};
   result.figures["labels"] = options.labels.string();
   result.figures["database"] = options.db.filename().string();
-  result.figures["index"] = index->Backend();
+  result.figures["index"] = index.Backend();
   result.figures["hand"] = options.hand;
   result.figures["refine"] = options.refine;
   result.figures["machine"] = MachineDescription();
@@ -162,27 +161,20 @@ void WritePoseStudy(const PoseStudyResult& result, const std::filesystem::path& 
   for (const auto& [stem, image] : PlotPoseStudy(result)) WriteImageAtomic(out_dir / (stem + ".png"), image);
 }
 
-std::filesystem::path IndexPath(const EvalPoseStudyCommandOptions& options) {
-  return IndexPathOf(options.db, options.index);
-}
-
-// What a pose study reads, opened in place (the index refers to the database).
-struct LoadedStudy {
+// What a pose study reads, opened once its options and outputs are checked.
+struct LoadedStudy : OpenedFiles {
   LoadedStudy(const EvalPoseStudyCommandOptions& options, const std::string& command)
-      : db(Open(options, command)), index(LoadIndex(IndexPath(options), db)),
-        hand(HandModel::Load(Handedness::kRight, options.asset_dir)) {}
-  static Database Open(const EvalPoseStudyCommandOptions& options, const std::string& command) {
+      : OpenedFiles(Checked(options, command)) {}
+  static const EvalPoseStudyCommandOptions& Checked(const EvalPoseStudyCommandOptions& options,
+                                                     const std::string& command) {
     std::string why;
     NPHAND_THROW_CHECK(options.study.Check(&why), command, ": ", why);
     if (!options.out_dir.empty()) {
       CheckOutputFolder(options.out_dir, command + " --out");
-      CheckOutputsApart({{options.db, "--db"}, {IndexPath(options), "--index"}}, {{options.out_dir, command + " --out", {".json", ".png"}}});
+      CheckOutputsApart(options.Inputs(), {{options.out_dir, command + " --out", {".json", ".png"}}});
     }
-    return Database::Open(options.db);
+    return options;
   }
-  Database db;
-  std::unique_ptr<KnnIndex> index;
-  HandModel hand;
 };
 
 }  // namespace

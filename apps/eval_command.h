@@ -3,6 +3,7 @@
 
 #include <filesystem>
 
+#include "apps/estimator_files.h"
 #include "nphand/eval/ann_study.h"
 #include "nphand/eval/estimator_study.h"
 #include "nphand/eval/motion_check.h"
@@ -33,10 +34,7 @@ struct EvalAnnCommandOptions {
 
 AnnStudyResult RunEvalAnn(const EvalAnnCommandOptions& options);
 
-struct EvalEstimatorCommandOptions {
-  std::filesystem::path db = "out/nphand.db";
-  std::filesystem::path index;  // default: the database's path + ".idx"
-  std::filesystem::path asset_dir = DefaultAssetDir();
+struct EvalEstimatorCommandOptions : EstimatorFiles {
   std::filesystem::path out_dir;  // if set: <name>.json there
   std::string name = "estimator_study";
   EstimatorStudyOptions study;
@@ -61,10 +59,7 @@ struct EvalMotionCommandOptions {
 // The motion files read back against the poses (nphand/eval/motion_check.h).
 MotionCheck RunEvalMotion(const EvalMotionCommandOptions& options);
 
-struct EvalPoseStudyCommandOptions {
-  std::filesystem::path db = "out/nphand.db";
-  std::filesystem::path index;  // default: the database's path + ".idx"
-  std::filesystem::path asset_dir = DefaultAssetDir();
+struct EvalPoseStudyCommandOptions : EstimatorFiles {
   std::filesystem::path out_dir;  // if set: <part>.json and its plots there
   PoseStudyOptions study;
 };
@@ -80,11 +75,8 @@ nlohmann::json RunEvalAll(const EvalPoseStudyCommandOptions& options);
 
 // `nphand eval real`: the estimator on labelled real images and video (real-dev's format),
 // scored as real-dev's reference scorer does (eval/real_score.h).
-struct EvalRealCommandOptions {
+struct EvalRealCommandOptions : EstimatorFiles {
   std::filesystem::path labels;   // labels.jsonl; the files it names are relative to its folder
-  std::filesystem::path db = "out/nphand.db";
-  std::filesystem::path index;    // default: the database's path + ".idx"
-  std::filesystem::path asset_dir = DefaultAssetDir();
   std::filesystem::path out_dir;  // if set: real.json, real_predictions.jsonl, real_contact.png there
   bool faces = true;              // set faces aside (OpenCV's cascade)
   std::string hand = "given";     // "given": the labelled side; "auto": the estimator chooses

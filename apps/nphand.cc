@@ -56,6 +56,13 @@ void AddGraspCheck(CLI::Option* option) {
       "", "non-empty"));
 }
 
+// The files a command that estimates reads: one option group for every such command.
+void AddEstimatorFileOptions(CLI::App* cmd, nphand::EstimatorFiles& f) {
+  cmd->add_option("--db", f.db, "Database file")->capture_default_str();
+  cmd->add_option("--index", f.index, "Index file (default: the database's path + .idx)");
+  cmd->add_option("--asset-dir", f.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+}
+
 void AddRenderCommand(CLI::App& app, nphand::RenderCommandOptions& o) {
   CLI::App* cmd = app.add_subcommand("render", "Render a posed hand (and an object) to PNG: RGB, labels, depth, keypoints");
   cmd->add_option("--hand", o.hand, "Which hand: right or left")->capture_default_str();
@@ -146,8 +153,7 @@ void CatchStopSignals() {
 void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   CLI::App* cmd = app.add_subcommand("estimate", "Estimate the hand's 3D pose in every frame of a video, image folder or camera");
   nphand::EstimatorOptions& e = o.estimator;
-  cmd->add_option("--db", o.db, "Database file")->capture_default_str();
-  cmd->add_option("--index", o.index, "Index file (default: the database's path + .idx)");
+  AddEstimatorFileOptions(cmd, o);
   cmd->add_option("--input", o.input, "Video file, image folder (name order) or camera index")->required();
   cmd->add_option("--out", o.out, "JSON lines, one object per frame (docs/FORMAT.md)")->capture_default_str();
   cmd->add_option("--overlay", o.overlay, "Overlay video (.mp4): the skeleton, and the matched database view beside it");
@@ -182,7 +188,6 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
       ->capture_default_str();
   cmd->add_option("--fps", o.fps, "Frame rate of an image folder")->capture_default_str();
   cmd->add_option("--max-frames", o.max_frames, "Stop after this many frames (0: all)")->check(WholeNumber())->capture_default_str();
-  cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   cmd->callback([&o]() {
     // A stop signal ends the run after the current frame, with complete files, and the
     // status says it was stopped: 128 + the signal's number (130 for Ctrl-C).
@@ -202,8 +207,7 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   bench->require_subcommand(1);
   CLI::App* pipeline = bench->add_subcommand(
       "pipeline", "Frames per second of the whole estimator on one core, ms per stage, peak memory");
-  pipeline->add_option("--db", p.db, "Database file")->capture_default_str();
-  pipeline->add_option("--index", p.index, "Index file (default: the database's path + .idx)");
+  AddEstimatorFileOptions(pipeline, p);
   pipeline->add_option("--frames", p.frames, "Frames to time")->capture_default_str();
   pipeline->add_option("--width", p.width, "Frame width")->capture_default_str();
   pipeline->add_option("--height", p.height, "Frame height")->capture_default_str();
@@ -212,7 +216,6 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   pipeline->add_flag("--refine", p.refine, "Refine the best view's pose (its cost is ms.refine)");
   pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->check(WholeNumber())->capture_default_str();
   pipeline->add_option("--threads", p.threads, "OpenCV threads for the image work (1: one core)")->capture_default_str();
-  pipeline->add_option("--asset-dir", p.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   pipeline->add_flag("--json", json, "Print one JSON object");
   pipeline->callback([&p, &json]() {
     PrintJson(nphand::RunBenchPipeline(p), json);
@@ -360,8 +363,7 @@ void AddEvalEstimatorCommand(CLI::App* eval, nphand::EvalEstimatorCommandOptions
   CLI::App* cmd = eval->add_subcommand(
       "estimator", "The estimator's validation sweep: observation weight, prior, carried hypotheses and K on rendered sequences");
   nphand::EstimatorStudyOptions& s = o.study;
-  cmd->add_option("--db", o.db, "Database file")->capture_default_str();
-  cmd->add_option("--index", o.index, "Index file (default: the database's path + .idx)");
+  AddEstimatorFileOptions(cmd, o);
   cmd->add_option("--sequences", s.sequences, "Validation sequences")->capture_default_str();
   cmd->add_option("--frames", s.frames, "Frames per sequence")->capture_default_str();
   cmd->add_option("--width", s.width, "Frame width")->capture_default_str();
@@ -371,7 +373,6 @@ void AddEvalEstimatorCommand(CLI::App* eval, nphand::EvalEstimatorCommandOptions
   cmd->add_flag("--masks", s.masks, "Estimate from the rendered hand masks (the paper's input) instead of the RGB frames");
   cmd->add_option("--out", o.out_dir, "Folder for the JSON");
   cmd->add_option("--name", o.name, "File name of the JSON")->capture_default_str();
-  cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
   cmd->add_flag("--json", json, "Print JSON instead of the table");
   cmd->callback([&o, &json]() {
     const std::vector<nphand::EstimatorScore> scores = nphand::RunEvalEstimator(o);
@@ -413,9 +414,7 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   CLI::App* cmd = eval->add_subcommand(
       "real", "The estimator on labelled real images and video (real-dev's labels.jsonl), scored as real-dev's reference does");
   cmd->add_option("--labels", o.labels, "labels.jsonl (its files are relative to its folder)")->required();
-  cmd->add_option("--db", o.db, "Database file")->capture_default_str();
-  cmd->add_option("--index", o.index, "Index file (default: the database's path + .idx)");
-  cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+  AddEstimatorFileOptions(cmd, o);
   cmd->add_option("--out", o.out_dir, "Folder for real.json, real_predictions.jsonl and real_contact.png");
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
   cmd->add_flag("--refine", o.refine, "Refine each estimate's best view against the hand's silhouette");
@@ -432,9 +431,7 @@ void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOption
   const auto add = [&](const char* name, const char* help) {
     CLI::App* cmd = eval->add_subcommand(name, help);
     nphand::PoseStudyOptions& s = o.study;
-    cmd->add_option("--db", o.db, "Database file")->capture_default_str();
-    cmd->add_option("--index", o.index, "Index file (default: the database's path + .idx)");
-    cmd->add_option("--asset-dir", o.asset_dir, "Folder holding right.glb and left.glb")->capture_default_str();
+    AddEstimatorFileOptions(cmd, o);
     cmd->add_option("--out", o.out_dir, "Folder for the JSON and the plots");
     cmd->add_option("--frames", s.frames, "Frames per test sequence")->capture_default_str();
     cmd->add_option("--width", s.width, "Frame width")->capture_default_str();

@@ -163,6 +163,17 @@ TEST_F(EstimateCommandTest, BadInputsGiveTheirErrors) {
   RunIndexBuild(index);
   options.index = other.string() + ".idx";
   testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "another database");
+  // Every command that estimates opens its files one way, with one set of messages.
+  BenchPipelineOptions bench;
+  bench.db = *dir_ / "missing.db";
+  testing::ExpectError([&] { RunBenchPipeline(bench); }, "missing.db: no database there (make one with `nphand db build`)");
+  EvalEstimatorCommandOptions sweep;
+  sweep.db = *dir_ / "tiny.db";
+  sweep.index = *dir_ / "missing.idx";
+  testing::ExpectError([&] { RunEvalEstimator(sweep); }, "missing.idx: no index there (make one with `nphand index build --db");
+  EvalPoseStudyCommandOptions study;
+  study.db = *dir_ / "missing.db";
+  testing::ExpectError([&] { RunEvalPoseStudy(PoseStudyPart::kNoise, study); }, "no database there");
   options = Options();
   options.prior = "max";
   testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "none, product or sum");
