@@ -445,44 +445,68 @@ FrameResult Estimator::EstimateHand(const cv::Mat& hand_mask, cv::Rect box, Fram
   return held;
 }
 
-FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result) {
+namespace {
+
+// A neighbour as a hypothesis: its entry, which crop found it, its feature distance, the
+// image-plane turn from the entry's view to the crop's, its pose vector so turned, and its
+// weight.
+struct Candidate {
+  uint32_t entry;
+  EntryMeta meta;
+  int turn_of;
+  double distance;
+  double turn;
+  PoseX x;
+  double w = 0.0;
+};
+
+}  // namespace
+
+// A frame's region as it passes Estimate's stages.
+struct Estimator::Lookup {
+  cv::Rect roi;                       // the hand's box, padded, within the frame
+  std::vector<HandCrop> crops;        // the crop, and its half turn when its ends look alike
+  std::vector<Descriptor> descriptors;
+  std::vector<Neighbours> found;      // per crop
+  std::vector<Candidate> hyp;
+  std::vector<size_t> order;          // hyp by weight, best first
+  const Candidate& best() const { return hyp[order[0]]; }
+};
+
+bool Estimator::Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, Lookup* lookup, FrameResult* result) {
   // Describe the hand's pixels within a padded box (turning a whole frame would cost more).
-  Clock::time_point t = Clock::now();
-  const cv::Rect roi = cv::Rect(box.x - 2, box.y - 2, box.width + 4, box.height + 4) & cv::Rect(0, 0, frame.width, frame.height);
+  const Clock::time_point t = Clock::now();
+  lookup->roi = cv::Rect(box.x - 2, box.y - 2, box.width + 4, box.height + 4) & cv::Rect(0, 0, frame.width, frame.height);
   const DescriptorConfig& config = db_.descriptor();
-  const std::optional<HandCrop> crop = CropHand(hand_mask(roi), config.Crop());
+  const std::optional<HandCrop> crop = CropHand(hand_mask(lookup->roi), config.Crop());
   NPHAND_CHECK(crop.has_value(), "a non-empty box gave no crop");
   const double elongation = Elongation(crop->image);
   if (elongation > options_.max_elongation) {
-    result.status = FrameStatus::kNotAHand;
-    result.reason = "too thin for a hand (principal axes " + std::to_string(elongation) + " : 1, more than " +
-                    std::to_string(options_.max_elongation) + ")";
-    result.box = box;
-    result.ms.describe = Ms(t, Clock::now());
-    return result;
+    result->status = FrameStatus::kNotAHand;
+    result->reason = "too thin for a hand (principal axes " + std::to_string(elongation) + " : 1, more than " +
+                     std::to_string(options_.max_elongation) + ")";
+    result->box = box;
+    result->ms.describe = Ms(t, Clock::now());
+    return false;
   }
-  std::vector<HandCrop> crops = {*crop};
-  if (config.normalize_roll && crop->roll_skewness < options_.roll_ambiguity) crops.push_back(HalfTurn(*crop));
-  std::vector<Descriptor> descriptors;
-  for (const HandCrop& c : crops) descriptors.push_back(DescribeCrop(c, config));
-  result.both_turns = crops.size() == 2;
-  result.ms.describe = Ms(t, Clock::now());
+  lookup->crops = {*crop};
+  if (config.normalize_roll && crop->roll_skewness < options_.roll_ambiguity) lookup->crops.push_back(HalfTurn(*crop));
+  for (const HandCrop& c : lookup->crops) lookup->descriptors.push_back(DescribeCrop(c, config));
+  result->both_turns = lookup->crops.size() == 2;
+  result->ms.describe = Ms(t, Clock::now());
+  return true;
+}
 
-  t = Clock::now();
-  std::vector<Neighbours> found;
-  for (const Descriptor& d : descriptors) found.push_back(index_.Search(d, options_.k));
-  result.ms.search = Ms(t, Clock::now());
+void Estimator::Search(Lookup* lookup, FrameResult* result) const {
+  const Clock::time_point t = Clock::now();
+  for (const Descriptor& d : lookup->descriptors) lookup->found.push_back(index_.Search(d, options_.k));
+  result->ms.search = Ms(t, Clock::now());
+}
 
-  t = Clock::now();
-  struct Candidate {
-    uint32_t entry;
-    EntryMeta meta;
-    int turn_of;  // which crop
-    double distance;
-    double turn;
-    PoseX x;
-    double w = 0.0;
-  };
+bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
+  const Clock::time_point t = Clock::now();
+  const DescriptorConfig& config = db_.descriptor();
+  const std::vector<Neighbours>& found = lookup->found;
   // The neighbours' rows lie anywhere in a table of tens of megabytes: ask for them all
   // before reading any, so that their cache misses overlap.
   size_t total = 0;
@@ -493,7 +517,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
       for (size_t line = 0; line < sizeof(EntryRow); line += 64) __builtin_prefetch(row + line);
     }
   }
-  std::vector<Candidate> hyp;
+  std::vector<Candidate>& hyp = lookup->hyp;
   hyp.reserve(total);
   for (size_t c = 0; c < found.size(); ++c) {
     for (size_t i = 0; i < found[c].ids.size(); ++i) {
@@ -502,7 +526,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
       h.turn_of = static_cast<int>(c);
       h.distance = std::sqrt(std::max(0.0f, found[c].distances[i]));
       h.meta = entries_[h.entry].meta;
-      h.turn = config.normalize_roll ? std::remainder(crops[c].roll - h.meta.roll, 2.0 * std::numbers::pi) : 0.0;
+      h.turn = config.normalize_roll ? std::remainder(lookup->crops[c].roll - h.meta.roll, 2.0 * std::numbers::pi) : 0.0;
       const PoseVector pose = PoseOf(h.entry);
       Eigen::Matrix3d entry_rotation;
       for (int r = 0; r < 3; ++r) {
@@ -519,17 +543,16 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   NPHAND_CHECK(!hyp.empty(), "the index returned no neighbours");
   double nearest = hyp[0].distance;
   for (const Candidate& h : hyp) nearest = std::min(nearest, h.distance);
-  result.searched = true;
-  result.nearest_distance = nearest;
+  result->searched = true;
+  result->nearest_distance = nearest;
   if (nearest > options_.max_distance) {
-    result.status = FrameStatus::kNotAHand;
-    result.reason = "nothing in the database looks like this region (nearest feature distance " +
-                    std::to_string(nearest) + " > " + std::to_string(options_.max_distance) + ")";
-    result.box = box;
-    result.ms.weigh = Ms(t, Clock::now());
-    return result;
+    result->status = FrameStatus::kNotAHand;
+    result->reason = "nothing in the database looks like this region (nearest feature distance " +
+                     std::to_string(nearest) + " > " + std::to_string(options_.max_distance) + ")";
+    result->box = box;
+    result->ms.weigh = Ms(t, Clock::now());
+    return false;
   }
-
   // Observation weights, as logarithms until normalised.
   std::vector<double> log_w(hyp.size());
   if (options_.observation == ObservationWeight::kFixed) {
@@ -553,10 +576,11 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
 
   std::vector<PoseX> poses(hyp.size());
   for (size_t i = 0; i < hyp.size(); ++i) poses[i] = hyp[i].x;
-  w = CombineWithPrior(poses, w, carried_, options_, &result.prior_used);
+  w = CombineWithPrior(poses, w, carried_, options_, &result->prior_used);
   for (size_t i = 0; i < hyp.size(); ++i) hyp[i].w = w[i];
 
-  std::vector<size_t> order(hyp.size());
+  std::vector<size_t>& order = lookup->order;
+  order.resize(hyp.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return hyp[a].w > hyp[b].w; });
   const Candidate& best = hyp[order[0]];
@@ -583,17 +607,17 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
     if ((h.x - best.x).norm() < options_.sigma_x) mode += h.w;
   }
   for (int g = 1; g <= kNumGrasps; ++g) {
-    if (grasp_mass[g] > 0.0) result.grasps.emplace_back(GraspKey(GraspTaxonomy()[g - 1]), grasp_mass[g]);
+    if (grasp_mass[g] > 0.0) result->grasps.emplace_back(GraspKey(GraspTaxonomy()[g - 1]), grasp_mass[g]);
   }
   for (size_t o = 0; o < object_mass.size(); ++o) {
     if (object_mass[o] <= 0.0) continue;
-    result.objects.emplace_back(o == kNoObject ? std::string("none") : ToString(static_cast<ObjectShape>(o)), object_mass[o]);
+    result->objects.emplace_back(o == kNoObject ? std::string("none") : ToString(static_cast<ObjectShape>(o)), object_mass[o]);
   }
   auto by_weight = [](const auto& a, const auto& b) { return a.second != b.second ? a.second > b.second : a.first < b.first; };
-  std::sort(result.grasps.begin(), result.grasps.end(), by_weight);
-  std::sort(result.objects.begin(), result.objects.end(), by_weight);
-  result.effective_samples = squares > 0.0 ? 1.0 / squares : 0.0;
-  result.confidence = std::min(1.0, mode);
+  std::sort(result->grasps.begin(), result->grasps.end(), by_weight);
+  std::sort(result->objects.begin(), result->objects.end(), by_weight);
+  result->effective_samples = squares > 0.0 ? 1.0 / squares : 0.0;
+  result->confidence = std::min(1.0, mode);
 
   for (size_t r = 0; r < order.size() && static_cast<int>(r) < options_.top_n; ++r) {
     const Candidate& h = hyp[order[r]];
@@ -605,46 +629,53 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
     out.pose.angles = AnglesOf(h.entry);
     out.pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), h.turn) *
                                 CameraFromHand(ViewpointFromDirection(directions_[h.meta.viewpoint]));
-    result.top.push_back(out);
+    result->top.push_back(out);
   }
-  result.pose = result.top[0].pose;
-  result.ms.weigh = Ms(t, Clock::now());
+  result->pose = result->top[0].pose;
+  result->ms.weigh = Ms(t, Clock::now());
+  return true;
+}
 
-  const HandCrop& query_crop = crops[best.turn_of];
+std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup, double* turn, FrameResult* result) {
+  const Candidate& best = lookup.best();
+  const HandCrop& query_crop = lookup.crops[best.turn_of];
   // Refinement: the best entry's pose moved until its silhouette agrees with the query's;
   // it then stands for the entry in what follows.
-  const EntryPlacement& lookup_place = PlacementOf(best.entry);
   std::optional<EntryPlacement> refined;
-  double turn = best.turn;  // the image-plane turn from the database's camera to the frame's
   if (refiner_.has_value()) {
-    t = Clock::now();
+    const Clock::time_point t = Clock::now();
+    const EntryPlacement& lookup_place = PlacementOf(best.entry);
     // While the track holds (the prior took part), the side's refined rotation of the frame
     // before, in this entry's image plane.
-    const size_t side = result.hand == Handedness::kRight ? 0 : 1;
-    if (refined_[side].frame != result.frame) refined_before_[side] = refined_[side];
+    const size_t side = result->hand == Handedness::kRight ? 0 : 1;
+    if (refined_[side].frame != result->frame) refined_before_[side] = refined_[side];
     const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -best.turn) * refined_before_[side].rotation;
-    const bool track = result.prior_used && refined_before_[side].frame == result.frame - 1;
+    const bool track = result->prior_used && refined_before_[side].frame == result->frame - 1;
     const Refinement r = refiner_->Refine(query_crop, EntryScene(best.entry), lookup_place.crop_from_image,
                                           track ? &previous : nullptr);
-    result.refined = r.moved;
-    result.refine_objective = std::make_pair(r.objective_before, r.objective_after);
+    result->refined = r.moved;
+    result->refine_objective = std::make_pair(r.objective_before, r.objective_after);
     if (r.moved) {
       refined = EntryPlacement{best.entry, 0, r.crop_from_image, hand_.KeypointsOf(r.scene.hand), r.scene.wrist_in_camera};
       // The silhouette turned counter-clockwise in the crop stands for a hand turned the
       // other way in the frame.
-      turn = best.turn - r.turn;
-      result.pose.angles = r.scene.hand.angles;
-      result.pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), best.turn) * RotationOf(r);
+      *turn = best.turn - r.turn;
+      result->pose.angles = r.scene.hand.angles;
+      result->pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), best.turn) * RotationOf(r);
     }
-    refined_[side] = {result.pose.camera_from_hand, result.frame};
-    result.ms.refine = Ms(t, Clock::now());
+    refined_[side] = {result->pose.camera_from_hand, result->frame};
+    result->ms.refine = Ms(t, Clock::now());
   }
+  return refined;
+}
 
-  // Placement: the best entry rendered as the database saw it tells where its keypoints lie
-  // in its crop; the query's crop maps them into the frame, and the two crops' scales give
-  // the distance.
-  t = Clock::now();
-  const EntryPlacement& entry = refined.has_value() ? *refined : lookup_place;
+void Estimator::Place(const Lookup& lookup, const EntryPlacement& entry, double turn, cv::Rect box, cv::Size frame,
+                      FrameResult* result) {
+  // The entry rendered as the database saw it tells where its keypoints lie in its crop;
+  // the query's crop maps them into the frame, and the two crops' scales give the distance.
+  const Clock::time_point t = Clock::now();
+  const HandCrop& query_crop = lookup.crops[lookup.best().turn_of];
+  const cv::Rect roi = lookup.roi;
   const cv::Matx23d frame_from_crop = Invert(query_crop.crop_from_image);
   const double size = options_.hand_length_m / model_hand_length_;
   const Intrinsics& camera = intrinsics_for(frame);
@@ -666,18 +697,30 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   const double range = db_distance_ * (camera.fx / db_intrinsics_.fx) * size *
                        (Scale(query_crop.crop_from_image) / Scale(entry.crop_from_image));
   const Eigen::Matrix3d rotation = towards_ray * AxisAngle(Eigen::Vector3d::UnitZ(), turn);
-  result.pose.camera_from_hand = towards_ray * result.pose.camera_from_hand;
-  for (Hypothesis& h : result.top) h.pose.camera_from_hand = towards_ray * h.pose.camera_from_hand;
-  const Eigen::Vector3d wrist = range * ray - size * (result.pose.camera_from_hand * hand_.bind_centre());
-  result.depth_m = range * ray.z();
+  result->pose.camera_from_hand = towards_ray * result->pose.camera_from_hand;
+  for (Hypothesis& h : result->top) h.pose.camera_from_hand = towards_ray * h.pose.camera_from_hand;
+  const Eigen::Vector3d wrist = range * ray - size * (result->pose.camera_from_hand * hand_.bind_centre());
+  result->depth_m = range * ray.z();
   for (int k = 0; k < kNumKeypoints; ++k) {
-    result.keypoints_2d[k] = to_frame(Project(db_intrinsics_, entry.wrist_in_camera + entry.keypoints[k]));
-    result.keypoints_hand[k] = size * (rotation * entry.keypoints[k]);
-    result.keypoints_camera[k] = wrist + result.keypoints_hand[k];
+    result->keypoints_2d[k] = to_frame(Project(db_intrinsics_, entry.wrist_in_camera + entry.keypoints[k]));
+    result->keypoints_hand[k] = size * (rotation * entry.keypoints[k]);
+    result->keypoints_camera[k] = wrist + result->keypoints_hand[k];
   }
-  result.box = box;
-  result.status = FrameStatus::kDetected;
-  result.ms.place = Ms(t, Clock::now());
+  result->box = box;
+  result->status = FrameStatus::kDetected;
+  result->ms.place = Ms(t, Clock::now());
+}
+
+FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result) {
+  Lookup lookup;
+  if (!Describe(hand_mask, box, frame, &lookup, &result)) return result;
+  Search(&lookup, &result);
+  if (!Weigh(box, &lookup, &result)) return result;
+  // The image-plane turn from the database's camera to the frame's; the refinement (if on)
+  // may turn it further, and its pose then stands for the best entry's.
+  double turn = lookup.best().turn;
+  const std::optional<EntryPlacement> refined = Refine(lookup, &turn, &result);
+  Place(lookup, refined.has_value() ? *refined : PlacementOf(lookup.best().entry), turn, box, frame, &result);
   return result;
 }
 

@@ -199,6 +199,22 @@ class Estimator {
   // time filled in. A region unlike any view leaves the carried hypotheses as they were
   // (the caller may try another region, and forgets them if none is a hand).
   FrameResult Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result);
+  // Estimate's stages, each timed into the result's ms; the lookup carries what they find.
+  struct Lookup;
+  // The crop (and its half turn) and their descriptors; false (with the reason) for a
+  // silhouette too thin to be a hand.
+  bool Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, Lookup* lookup, FrameResult* result);
+  void Search(Lookup* lookup, FrameResult* result) const;
+  // Hypotheses, observation weights, the prior, the carried hypotheses, the posteriors and
+  // the top-N; false (with the reason) when nothing in the database is near.
+  bool Weigh(cv::Rect box, Lookup* lookup, FrameResult* result);
+  // With refine: the best entry's pose refined against the crop (its placement, and the
+  // turn it adds), else nothing.
+  struct EntryPlacement;
+  std::optional<EntryPlacement> Refine(const Lookup& lookup, double* turn, FrameResult* result);
+  // Keypoints in the frame and in 3D, from `entry`'s render and crop turned by `turn`.
+  void Place(const Lookup& lookup, const EntryPlacement& entry, double turn, cv::Rect box, cv::Size frame,
+             FrameResult* result);
   // Estimate for a hand of side `side`: a left hand's mask is mirrored into the right-hand
   // database, and its result mirrored back.
   FrameResult EstimateSide(const cv::Mat& hand_mask, cv::Rect box, Handedness side, FrameResult result);
