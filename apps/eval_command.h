@@ -8,6 +8,7 @@
 #include "nphand/eval/estimator_study.h"
 #include "nphand/eval/motion_check.h"
 #include "nphand/eval/pose_errors.h"
+#include "nphand/eval/pose_report.h"
 #include "nphand/eval/pose_study.h"
 #include "nphand/eval/feature_study.h"
 

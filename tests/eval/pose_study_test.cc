@@ -11,6 +11,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "nphand/db/builder.h"
+#include "nphand/eval/pose_methods.h"
+#include "nphand/eval/pose_report.h"
 #include "nphand/index/exact_index.h"
 #include "testing/testing.h"
 

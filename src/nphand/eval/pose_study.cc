@@ -3,21 +3,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <iomanip>
 #include <limits>
 #include <numbers>
-#include <sstream>
 
-#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
-#include "nphand/eval/json_lines.h"
 #include "nphand/eval/measures.h"
-#include "nphand/eval/plot.h"
-#include "nphand/features/crop.h"
-#include "nphand/features/descriptor.h"
+#include "nphand/eval/pose_methods.h"
 #include "nphand/index/exact_index.h"
-#include "nphand/render/renderer.h"
 #include "nphand/util/check.h"
 #include "nphand/util/progress.h"
 #include "nphand/util/random.h"
@@ -27,209 +20,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-Eigen::Matrix3d RotationOf(const PoseVector& x) {
-  Eigen::Matrix3d r;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) r(i, j) = x[3 * i + j];
-  }
-  return r;
-}
-
-void SetRotation(const Eigen::Matrix3d& r, PoseVector* x) {
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) (*x)[3 * i + j] = r(i, j);
-  }
-}
-
-// What the mask-reading methods take from a mask: the crop and descriptor the database
-// would have made, and the rotation from the camera's axis to the ray through the hand.
-struct MaskView {
-  HandCrop crop;
-  Descriptor descriptor;
-  Eigen::Matrix3d towards_ray;
-};
-
-std::optional<MaskView> ViewOf(const cv::Mat& mask, const DescriptorConfig& config, const Intrinsics& camera) {
-  const cv::Rect box = cv::boundingRect(mask);
-  if (box.area() == 0) return std::nullopt;
-  const cv::Rect roi = cv::Rect(box.x - 2, box.y - 2, box.width + 4, box.height + 4) & cv::Rect(0, 0, mask.cols, mask.rows);
-  const std::optional<HandCrop> crop = CropHand(mask(roi) != 0, config.Crop());
-  if (!crop) return std::nullopt;
-  MaskView view{*crop, DescribeCrop(*crop, config), Eigen::Matrix3d::Identity()};
-  const cv::Moments m = cv::moments(mask, true);
-  const Eigen::Vector3d ray =
-      Eigen::Vector3d((m.m10 / m.m00 + 0.5 - camera.cx) / camera.fx, (m.m01 / m.m00 + 0.5 - camera.cy) / camera.fy, 1.0)
-          .normalized();
-  view.towards_ray = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), ray).toRotationMatrix();
-  return view;
-}
-
-// A roll-normalised pose vector seen in the frame: turned by `roll` and towards the ray.
-HandPose PoseInFrame(const PoseVector& normalised, double roll, const Eigen::Matrix3d& towards_ray) {
-  HandPose pose = FromPoseVector(normalised, Handedness::kRight);
-  pose.camera_from_hand = towards_ray * AxisAngle(Eigen::Vector3d::UnitZ(), roll) * pose.camera_from_hand;
-  return pose;
-}
-
-// Every entry with a hand: its pose vector with the rotation roll-normalised
-// (Rz(-roll) R, the frame the descriptor was computed in).
-struct NormalisedPoses {
-  std::vector<entry_id_t> ids;
-  Eigen::MatrixXd x;  // kPoseVectorSize x ids.size()
-};
-
-NormalisedPoses NormalisedPosesOf(const Database& db) {
-  NormalisedPoses out;
-  out.ids = DatabaseHandIds(db);
-  out.x.resize(kPoseVectorSize, static_cast<Eigen::Index>(out.ids.size()));
-  size_t row = 0;
-  ScanRecords(db, [&](size_t i) {
-    if (row >= out.ids.size() || out.ids[row] != i) return;
-    PoseVector x = db.Pose(i);
-    SetRotation(AxisAngle(Eigen::Vector3d::UnitZ(), -db.Meta(i).roll) * RotationOf(x), &x);
-    out.x.col(static_cast<Eigen::Index>(row++)) = x;
-  });
-  NPHAND_CHECK(row == out.ids.size(), "database entries changed while read");
-  return out;
-}
-
-class EstimatorMethod : public PoseMethod {
- public:
-  EstimatorMethod(std::string name, const Database& db, const KnnIndex& index, const HandModel& hand,
-                  const EstimatorOptions& options, bool from_rgb)
-      : name_(std::move(name)), estimator_(db, index, hand, options), from_rgb_(from_rgb), backend_(index.Backend()) {}
-  std::string Name() const override { return name_; }
-  bool FromRgb() const override { return from_rgb_; }
-  void Reset() override { estimator_.Reset(); }
-  MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) override {
-    const FrameResult r = from_rgb_ ? estimator_.Process(frame.truth.rgb, frame.truth.time_s)
-                                    : estimator_.ProcessMask(mask, frame.truth.time_s);
-    MethodEstimate out;
-    out.detected = r.detected();
-    if (out.detected) {
-      out.pose = r.pose;
-      out.keypoints_2d = r.keypoints_2d;
-    }
-    return out;
-  }
-  nlohmann::json Describe() const override {
-    const EstimatorOptions& o = estimator_.options();
-    return {{"index", backend_},         {"k", o.k},           {"observation", ToString(o.observation)},
-            {"sigma_y", o.sigma_y},      {"prior", ToString(o.prior)}, {"sigma_x", o.sigma_x},
-            {"carried", o.carried},      {"input", from_rgb_ ? "rgb" : "mask"},
-            {"refine", RefinementJson(o)}};
-  }
-
- private:
-  std::string name_;
-  Estimator estimator_;
-  bool from_rgb_;
-  std::string backend_;
-};
-
-class NearestPoseMethod : public PoseMethod {
- public:
-  explicit NearestPoseMethod(const Database& db) : config_(db.descriptor()), poses_(NormalisedPosesOf(db)) {}
-  std::string Name() const override { return "NN pose"; }
-  MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) override {
-    const std::optional<MaskView> view = ViewOf(mask, config_, frame.intrinsics);
-    if (!view) return {};
-    const PoseVector truth = ToPoseVector(frame.truth.pose);
-    // |A N - R| = |N - A^T R| for a rotation A: the truth is brought into each turn's
-    // normalised frame once, instead of every entry into the frame.
-    double best = std::numeric_limits<double>::infinity();
-    PoseVector best_x = PoseVector::Zero();
-    double best_roll = 0.0;
-    for (double roll : {view->crop.roll, view->crop.roll + std::numbers::pi}) {
-      PoseVector target = truth;
-      SetRotation((view->towards_ray * AxisAngle(Eigen::Vector3d::UnitZ(), roll)).transpose() * RotationOf(truth), &target);
-      Eigen::Index at = 0;
-      const double d = (poses_.x.colwise() - target).colwise().squaredNorm().minCoeff(&at);
-      if (d < best) {
-        best = d;
-        best_x = poses_.x.col(at);
-        best_roll = roll;
-      }
-    }
-    return {true, PoseInFrame(best_x, best_roll, view->towards_ray), std::nullopt};
-  }
-
- private:
-  DescriptorConfig config_;
-  NormalisedPoses poses_;
-};
-
-class MeanPoseMethod : public PoseMethod {
- public:
-  explicit MeanPoseMethod(const Database& db) : config_(db.descriptor()), mean_(NormalisedPosesOf(db).x.rowwise().mean()) {}
-  std::string Name() const override { return "mean pose"; }
-  MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) override {
-    const std::optional<MaskView> view = ViewOf(mask, config_, frame.intrinsics);
-    if (!view) return {};
-    return {true, PoseInFrame(mean_, view->crop.roll, view->towards_ray), std::nullopt};
-  }
-
- private:
-  DescriptorConfig config_;
-  PoseVector mean_;
-};
-
-class RegressionMethod : public PoseMethod {
- public:
-  RegressionMethod(const Database& db, std::unique_ptr<PoseRegressor> regressor, int rows, uint64_t seed,
-                   std::ostream* progress)
-      : config_(db.descriptor()), regressor_(std::move(regressor)) {
-    const NormalisedPoses poses = NormalisedPosesOf(db);
-    NPHAND_THROW_CHECK(rows >= 2 && static_cast<size_t>(rows) <= poses.ids.size(), regressor_->Name(),
-                       ": the fit needs 2..", poses.ids.size(), " rows, not ", rows);
-    // Rows drawn without replacement (a partial Fisher-Yates shuffle), then in file order.
-    std::vector<size_t> order(poses.ids.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    Random random(seed);
-    for (int i = 0; i < rows; ++i) std::swap(order[i], order[i + random.UniformIndex(order.size() - i)]);
-    order.resize(rows);
-    std::sort(order.begin(), order.end());
-    std::vector<entry_id_t> ids;
-    for (size_t r : order) ids.push_back(poses.ids[r]);
-    const int d = config_.Dimension();
-    Eigen::MatrixXd x(rows, d), y(rows, kPoseVectorSize);
-    ForEachRow(db, ids, [&](size_t row, std::span<const float> hog) {
-      for (int c = 0; c < d; ++c) x(static_cast<Eigen::Index>(row), c) = hog[c];
-    });
-    for (int r = 0; r < rows; ++r) y.row(r) = poses.x.col(static_cast<Eigen::Index>(order[r])).transpose();
-    const Clock::time_point start = Clock::now();
-    if (progress != nullptr) *progress << regressor_->Name() << ": fitting on " << rows << " entries\n";
-    regressor_->Fit(x, y);
-    fit_seconds_ = std::chrono::duration<double>(Clock::now() - start).count();
-    rows_ = rows;
-  }
-  std::string Name() const override { return regressor_->Name(); }
-  MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) override {
-    const std::optional<MaskView> view = ViewOf(mask, config_, frame.intrinsics);
-    if (!view) return {};
-    Eigen::MatrixXd x(1, config_.Dimension());
-    for (int c = 0; c < config_.Dimension(); ++c) x(0, c) = view->descriptor.values[c];
-    const PoseVector predicted = regressor_->Predict(x).row(0).transpose();
-    return {true, PoseInFrame(predicted, view->crop.roll, view->towards_ray), std::nullopt};
-  }
-  nlohmann::json Describe() const override {
-    const RegressorSummary s = regressor_->Summary();
-    return {{"rows", rows_},
-            {"fit_s", fit_seconds_},
-            {"length_scale", s.length_scale},
-            {"noise_sd", s.noise_sd},
-            {"log_marginal", s.log_marginal},
-            {"basis", s.basis},
-            {"iterations", s.iterations}};
-  }
-
- private:
-  DescriptorConfig config_;
-  std::unique_ptr<PoseRegressor> regressor_;
-  int rows_ = 0;
-  double fit_seconds_ = 0.0;
-};
 
 // One method's per-frame figures, gathered before they are summed.
 struct FrameFigures {
@@ -422,20 +212,6 @@ cv::Mat SegmentationNoise(const cv::Mat& mask, double alpha_percent, uint64_t se
   return out;
 }
 
-std::unique_ptr<PoseMethod> MakeEstimatorMethod(const std::string& name, const Database& db, const KnnIndex& index,
-                                                const HandModel& hand, const EstimatorOptions& options, bool from_rgb) {
-  return std::make_unique<EstimatorMethod>(name, db, index, hand, options, from_rgb);
-}
-
-std::unique_ptr<PoseMethod> MakeNearestPoseMethod(const Database& db) { return std::make_unique<NearestPoseMethod>(db); }
-
-std::unique_ptr<PoseMethod> MakeMeanPoseMethod(const Database& db) { return std::make_unique<MeanPoseMethod>(db); }
-
-std::unique_ptr<PoseMethod> MakeRegressionMethod(const Database& db, std::unique_ptr<PoseRegressor> regressor, int rows,
-                                                 uint64_t seed, std::ostream* progress) {
-  return std::make_unique<RegressionMethod>(db, std::move(regressor), rows, seed, progress);
-}
-
 std::vector<MethodScore> RunMethods(std::vector<std::unique_ptr<PoseMethod>>& methods,
                                     const std::vector<RenderedSequence>& sequences, const std::vector<double>& alphas,
                                     const HandModel& hand, uint64_t noise_seed, std::ostream* progress) {
@@ -519,29 +295,6 @@ std::vector<MethodScore> RunMethods(std::vector<std::unique_ptr<PoseMethod>>& me
   return scores;
 }
 
-nlohmann::json ToJson(const MethodScore& s) {
-  return {{"method", s.method},
-          {"sequence", s.sequence},
-          {"alpha", s.alpha},
-          {"frames", s.frames},
-          {"detected", s.detected},
-          {"no_hand_frames", s.no_hand_frames},
-          {"false_detections", s.false_detections},
-          {"pose_error", JsonNumber(s.pose_error)},
-          {"keypoint_error_mm", JsonNumber(s.keypoint_mm)},
-          {"pa_mpjpe_mm", JsonNumber(s.pa_mpjpe_mm)},
-          {"within_20mm", JsonNumber(s.within_20mm)},
-          {"auc_0_50", JsonNumber(s.auc_0_50)},
-          {"keypoint_px", JsonNumber(s.keypoint_px)},
-          {"joint_deg", JsonNumber(s.joint_deg)},
-          {"wrist_deg", JsonNumber(s.wrist_deg)},
-          {"jitter_mm", JsonNumber(s.jitter_mm)},
-          {"truth_jitter_mm", JsonNumber(s.truth_jitter_mm)},
-          {"ms_median", JsonNumber(s.ms_median)},
-          {"pose_error_normalised", JsonNumber(s.pose_error_norm)},
-          {"keypoint_error_normalised", JsonNumber(s.keypoint_norm)}};
-}
-
 nlohmann::json DescribeSequences(const std::vector<RenderedSequence>& sequences) {
   nlohmann::json out = nlohmann::json::array();
   for (const RenderedSequence& r : sequences) {
@@ -561,44 +314,6 @@ nlohmann::json DescribeSequences(const std::vector<RenderedSequence>& sequences)
   }
   return out;
 }
-
-std::string FormatScores(const std::vector<MethodScore>& scores, const std::string& sequence) {
-  std::ostringstream out;
-  out << std::left << std::setw(7) << "alpha" << std::setw(16) << "method" << std::right << std::setw(10) << "detected"
-      << std::setw(9) << "no-hand"
-      << std::setw(8) << "pose" << std::setw(7) << "/NN" << std::setw(9) << "kp_mm" << std::setw(7) << "/NN" << std::setw(8)
-      << "PA_mm" << std::setw(7) << "<20mm" << std::setw(7) << "AUC" << std::setw(7) << "px" << std::setw(8) << "wrist"
-      << std::setw(8) << "jitter" << std::setw(8) << "ms" << "\n";
-  out << std::fixed;
-  auto cell = [&](double v, int width, int precision) {
-    if (std::isfinite(v)) {
-      out << std::setprecision(precision) << std::setw(width) << v;
-    } else {
-      out << std::setw(width) << "-";
-    }
-  };
-  for (const MethodScore& s : scores) {
-    if (s.sequence != sequence) continue;
-    out << std::left << std::setprecision(1) << std::setw(7) << s.alpha << std::setw(16) << s.method << std::right
-        << std::setw(10) << (std::to_string(s.detected) + "/" + std::to_string(s.frames)) << std::setw(9)
-        << (s.no_hand_frames > 0 ? std::to_string(s.false_detections) + "/" + std::to_string(s.no_hand_frames) : "-");
-    cell(s.pose_error, 8, 3);
-    cell(s.pose_error_norm, 7, 2);
-    cell(s.keypoint_mm, 9, 1);
-    cell(s.keypoint_norm, 7, 2);
-    cell(s.pa_mpjpe_mm, 8, 1);
-    cell(s.within_20mm, 7, 2);
-    cell(s.auc_0_50, 7, 2);
-    cell(s.keypoint_px, 7, 1);
-    cell(s.wrist_deg, 8, 1);
-    cell(s.jitter_mm, 8, 2);
-    cell(s.ms_median, 8, 2);
-    out << "\n";
-  }
-  return out.str();
-}
-
-
 std::string ToString(PoseStudyPart part) {
   switch (part) {
     case PoseStudyPart::kBaselines:
@@ -672,13 +387,6 @@ PoseStudyResult RunPoseStudy(PoseStudyPart part, const Database& db, const KnnIn
   return result;
 }
 
-nlohmann::json ToJson(const PoseStudyResult& result) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (const MethodScore& s : result.scores) rows.push_back(ToJson(s));
-  return {{"part", result.part},   {"sequences", result.sequences}, {"methods", result.methods},
-          {"seconds", result.seconds}, {"rows", rows}};
-}
-
 PoseStudyResult BaselinesOf(const PoseStudyResult& noise) {
   PoseStudyResult out = noise;
   out.part = ToString(PoseStudyPart::kBaselines);
@@ -687,78 +395,6 @@ PoseStudyResult BaselinesOf(const PoseStudyResult& noise) {
     if (s.alpha == 0.0) out.scores.push_back(s);
   }
   return out;
-}
-
-std::vector<std::pair<std::string, cv::Mat>> PlotPoseStudy(const PoseStudyResult& result) {
-  std::vector<std::pair<std::string, cv::Mat>> plots;
-  std::vector<std::string> methods;
-  for (const MethodScore& s : result.scores) {
-    if (std::find(methods.begin(), methods.end(), s.method) == methods.end()) methods.push_back(s.method);
-  }
-  const auto at = [&](const std::string& method, const std::string& sequence, double alpha) -> const MethodScore* {
-    for (const MethodScore& s : result.scores) {
-      if (s.method == method && s.sequence == sequence && s.alpha == alpha) return &s;
-    }
-    return nullptr;
-  };
-  if (result.part == "robustness") {
-    std::vector<PlotSeries> series;
-    for (const std::string& m : methods) {
-      PlotSeries line{m, {}, {}};
-      for (size_t v = 0; v < result.sequences.size(); ++v) {
-        const MethodScore* s = at(m, result.sequences[v]["name"].get<std::string>(), 0.0);
-        line.x.push_back(static_cast<double>(v));
-        line.y.push_back(s != nullptr ? s->keypoint_mm : kNaN);
-      }
-      series.push_back(line);
-    }
-    std::string variants;
-    for (size_t v = 0; v < result.sequences.size(); ++v) {
-      variants += (v == 0 ? "" : ", ") + std::to_string(v) + " " + result.sequences[v]["name"].get<std::string>();
-    }
-    plots.emplace_back("robustness_errors", PlotLines(series, "3D keypoint error (mm) per variant", variants));
-  } else {
-    std::vector<std::string> names;
-    std::vector<double> values;
-    for (const std::string& m : methods) {
-      const MethodScore* s = at(m, "all", 0.0);
-      if (s == nullptr) continue;
-      names.push_back(m);
-      values.push_back(s->keypoint_norm);
-    }
-    plots.emplace_back(result.part + "_errors",
-                       PlotBars(names, values, "3D keypoint error / NN-pose bound's, clean masks (Fig. 6)"));
-  }
-  std::vector<PlotSeries> curves;
-  const std::string sequence = result.part == "robustness" ? "base" : "all";
-  for (const std::string& m : methods) {
-    const MethodScore* s = at(m, sequence, 0.0);
-    if (s == nullptr) continue;
-    PlotSeries curve{m, {}, {}};
-    for (int mm = 0; mm <= 50; mm += 2) {
-      curve.x.push_back(mm);
-      curve.y.push_back(FractionWithin(s->distances, mm / 1000.0));
-    }
-    curves.push_back(curve);
-  }
-  plots.emplace_back(result.part + "_curves",
-                     PlotLines(curves, "fraction of keypoints within a distance (" + sequence + ")", "mm"));
-  if (result.part == "noise") {
-    std::vector<PlotSeries> series;
-    for (const std::string& m : methods) {
-      PlotSeries line{m, {}, {}};
-      for (const MethodScore& s : result.scores) {
-        if (s.method == m && s.sequence == "all") {
-          line.x.push_back(s.alpha);
-          line.y.push_back(s.keypoint_mm);
-        }
-      }
-      if (line.x.size() > 1) series.push_back(line);
-    }
-    plots.emplace_back("noise_alpha", PlotLines(series, "3D keypoint error (mm) against segmentation noise (Fig. 7)",
-                                                "alpha: % of hand pixels removed"));
-  }
-  return plots;
 }
 
 }  // namespace nphand

@@ -1,7 +1,7 @@
 // The paper's experiments (PAPER.md Sec. 6, Figs. 6, 7 and 9) on our system: test
-// sequences whose grasps close onto objects the database lacks, every method of the
-// comparison behind one interface, the segmentation noise of Fig. 7, and the paper's and
-// today's measures per method, noise level and sequence.
+// sequences whose grasps close onto objects the database lacks, the segmentation noise of
+// Fig. 7, the methods (pose_methods.h) run over them, and the paper's and today's measures
+// per method, noise level and sequence; pose_report.h writes and plots the results.
 //
 // Methods see what the paper's experiments gave them: the hand's mask (the object leaves
 // its hole; no forearm), noisy or clean. The estimator is also run on the RGB frames, which
@@ -72,43 +72,6 @@ std::vector<RenderedSequence> RenderSequences(const HandModel& hand, const std::
 // the seed), then a 3 x 3 erosion and a 3 x 3 dilation. 0 gives the mask as it is.
 cv::Mat SegmentationNoise(const cv::Mat& mask, double alpha_percent, uint64_t seed);
 
-struct MethodEstimate {
-  bool detected = false;
-  HandPose pose;  // in the frame's camera
-  std::optional<std::array<Eigen::Vector2d, kNumKeypoints>> keypoints_2d;  // methods that place the hand
-};
-
-// One interface for every method of the comparison. Estimate sees the frame (for the
-// methods that read RGB, and for the NN-pose bound, which reads the truth) and the mask
-// to use (noisy or clean).
-class PoseMethod {
- public:
-  virtual ~PoseMethod() = default;
-  virtual std::string Name() const = 0;
-  // True when the method reads the RGB frame rather than the mask (noise does not apply).
-  virtual bool FromRgb() const { return false; }
-  // A new sequence.
-  virtual void Reset() {}
-  virtual MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) = 0;
-  // What was fitted or chosen, for reports.
-  virtual nlohmann::json Describe() const { return nlohmann::json::object(); }
-};
-
-// The estimator (ProcessMask, or Process on the RGB frame with `from_rgb`). With
-// options.prior kNone it is the paper's "NN feature".
-std::unique_ptr<PoseMethod> MakeEstimatorMethod(const std::string& name, const Database& db, const KnnIndex& index,
-                                                const HandModel& hand, const EstimatorOptions& options, bool from_rgb);
-// The database entry nearest to the truth in pose space, turned by the mask's roll (either
-// way round) and the ray to the hand: the lower bound of any method that answers with
-// database entries (the database's resolution).
-std::unique_ptr<PoseMethod> MakeNearestPoseMethod(const Database& db);
-// The mean of the database's roll-normalised pose vectors, turned as above.
-std::unique_ptr<PoseMethod> MakeMeanPoseMethod(const Database& db);
-// A regressor from the descriptor to the roll-normalised pose vector, fitted on `rows`
-// database entries with a hand drawn by `seed`, turned as above.
-std::unique_ptr<PoseMethod> MakeRegressionMethod(const Database& db, std::unique_ptr<PoseRegressor> regressor, int rows,
-                                                 uint64_t seed, std::ostream* progress);
-
 // A method's figures over a set of frames at one noise level.
 struct MethodScore {
   std::string method;
@@ -138,6 +101,8 @@ struct MethodScore {
   std::vector<double> distances;   // every keypoint distance (metres), for the error curves
 };
 
+class PoseMethod;  // pose_methods.h
+
 // Runs every method over every sequence at every noise level (RGB methods at alpha 0 only,
 // and then over the sequence's frames without a hand) and scores them over all sequences and
 // per sequence.
@@ -145,11 +110,7 @@ std::vector<MethodScore> RunMethods(std::vector<std::unique_ptr<PoseMethod>>& me
                                     const std::vector<RenderedSequence>& sequences, const std::vector<double>& alphas,
                                     const HandModel& hand, uint64_t noise_seed, std::ostream* progress);
 
-nlohmann::json ToJson(const MethodScore& score);
 nlohmann::json DescribeSequences(const std::vector<RenderedSequence>& sequences);
-// Rows of the scores whose sequence is `sequence`, one line per (alpha, method).
-std::string FormatScores(const std::vector<MethodScore>& scores, const std::string& sequence = "all");
-
 
 // The study's parts (`nphand eval baselines|noise|robustness`).
 enum class PoseStudyPart : uint8_t {
@@ -186,13 +147,7 @@ struct PoseStudyResult {
 PoseStudyResult RunPoseStudy(PoseStudyPart part, const Database& db, const KnnIndex& index, const HandModel& hand,
                              const EstimatorOptions& options_base, const PoseStudyOptions& options, std::ostream* progress);
 
-nlohmann::json ToJson(const PoseStudyResult& result);
 // The baselines part of a noise result: its rows at alpha 0.
 PoseStudyResult BaselinesOf(const PoseStudyResult& noise);
-// Plots of a result, by file stem: "<part>_errors" (Fig. 6: keypoint error normalised by
-// NN pose per method; for robustness, keypoint error per variant), "<part>_curves" (the
-// fraction of keypoints within a distance, 0-50 mm, per method), and for the noise part
-// "noise_alpha" (Fig. 7: keypoint error against alpha per method).
-std::vector<std::pair<std::string, cv::Mat>> PlotPoseStudy(const PoseStudyResult& result);
 
 }  // namespace nphand
