@@ -3,8 +3,8 @@
 #   find_package(nphand) ... target_link_libraries(app PRIVATE nphand::nphand)
 include(CMakePackageConfigHelpers)
 
-# Public headers. The index file's body reader and the adapters of the third-party index
-# libraries are internal: nothing public includes them.
+# Public headers. The glTF accessor reader, the index file's format and body reader, and the
+# adapters of the third-party index libraries are internal: nothing public includes them.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/nphand DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h"
         PATTERN "model/gltf_accessor.h" EXCLUDE

@@ -276,7 +276,8 @@ PYBIND11_MODULE(nphand, m) {
       .def(py::init([](const std::shared_ptr<Database>& db, const std::filesystem::path& path) {
              return std::shared_ptr<KnnIndex>(LoadIndex(path, *db));
            }),
-           py::arg("db"), py::arg("path"), "Loads an index file made for `db` (nphand index build)")
+           py::arg("db"), py::arg("path"), py::keep_alive<1, 2>(),
+           "Loads an index file made for `db` (nphand index build); the index keeps `db` alive")
       .def_static(
           "build",
           [](const std::shared_ptr<Database>& db, const std::string& backend) {
@@ -287,7 +288,8 @@ PYBIND11_MODULE(nphand, m) {
             py::gil_scoped_release release;
             return std::shared_ptr<KnnIndex>(BuildIndex(*db, options));
           },
-          py::arg("db"), py::arg("backend") = "hnswlib-sq8", "Builds an index in memory")
+          py::arg("db"), py::arg("backend") = "hnswlib-sq8", py::keep_alive<0, 1>(),
+          "Builds an index of `db` in memory; the index keeps `db` alive")
       .def(
           "save", [](const KnnIndex& index, const std::filesystem::path& path, const Database& db) { index.Save(path, db); },
           py::arg("path"), py::arg("db"), "Writes the index file (atomically) for the database it was built from")

@@ -7,7 +7,7 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds=60
-targets=(db_file db_content db_resume glb index index_body poses frames)
+targets=(db_file db_content db_resume glb index index_body poses frames motion)
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
@@ -86,6 +86,14 @@ mkdir -p "$seeds/poses"
 "$build/apps/nphand" estimate --db "$seeds/tiny.db" --index "$seeds/index/tiny.idx" --input "$seeds/sequence/frames" \
   --k 20 --max-distance 2 --top --no-faces --out "$seeds/poses/estimated.jsonl" >/dev/null 2>&1
 cp "$seeds/sequence/truth.jsonl" "$seeds/poses/truth.jsonl"
+# motion: a run's BVH and glTF (if it found a hand) behind the target's selector byte (0:
+# BVH, 1: glTF).
+mkdir -p "$seeds/motion"
+"$build/apps/nphand" estimate --db "$seeds/tiny.db" --index "$seeds/index/tiny.idx" --input "$seeds/sequence/frames" \
+  --k 20 --max-distance 2 --no-faces --out "$seeds/motion.jsonl" --bvh "$seeds/motion.bvh" --gltf "$seeds/motion.glb" \
+  >/dev/null 2>&1 || true
+[ -f "$seeds/motion.bvh" ] && { printf '\x00'; cat "$seeds/motion.bvh"; } >"$seeds/motion/motion.bvh"
+[ -f "$seeds/motion.glb" ] && { printf '\x01'; cat "$seeds/motion.glb"; } >"$seeds/motion/motion.glb"
 export NPHAND_FUZZ_TRUTH="$seeds/sequence/truth.jsonl"
 # frames: the sequence's first frame as PNG, JPEG (whole and cut short) and BMP, its video
 # and a Motion JPEG AVI, each behind the target's selector byte.

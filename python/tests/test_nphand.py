@@ -1,4 +1,5 @@
 """The Python module: arrays in and out, errors as exceptions, threads."""
+import gc
 import json
 import os
 import subprocess
@@ -134,3 +135,18 @@ def test_the_example_estimates_a_video(hand, frames, tmp_path):
     missing = subprocess.run([sys.executable, script, str(tmp_path / "clip.mp4"), "--db", str(tmp_path / "none.db")],
                              capture_output=True, text=True)
     assert missing.returncode == 1 and "estimate_video: error: " in missing.stderr
+
+
+def test_an_index_keeps_its_database_alive(hand, tmp_path):
+    path = tmp_path / "kept.db"
+    nphand.build_database(hand, path, grasps=[1], directions=8, image_size=96, threads=1)
+    # Neither index's own database object is kept here: the index keeps it alive.
+    index = nphand.Index.build(nphand.Database(path), "hnswlib-sq8")
+    gc.collect()
+    db = nphand.Database(path)
+    index.save(str(path) + ".idx", db)
+    loaded = nphand.Index(nphand.Database(path), str(path) + ".idx")
+    gc.collect()
+    frame = nphand.render(hand, grasp="large_diameter", width=320, height=240)
+    result = nphand.Estimator(db, loaded, hand, k=10, faces=False).process(frame["rgb"])
+    assert result.status != "no_skin", "the hand was looked up in the index"

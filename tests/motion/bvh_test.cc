@@ -93,6 +93,8 @@ TEST(BvhTest, MalformedFilesAreRefusedWithTheLine) {
       {head + "MOTION\nFrames: 1\nFrame Time: 0.04\n1 2 3 4\n", "more values than 1 frames hold"},
       {head + "MOTION\nFrames: 1\nFrame Time: 0\n1 2 3\n", "the frame time must be positive"},
       {"HIERARCHY\nJOINT a\n", "JOINT outside any joint"},
+      {"HIERARCHY\nROOT a\n{\n  OFFSET 0 0 0\n  CHANNELS 0\n}\nMOTION\nFrames: 9999999\nFrame Time: 0.04\n",
+       "no channels"},
   };
   for (const auto& c : cases) {
     try {

@@ -255,6 +255,7 @@ Bvh ParseBvh(const std::string& text, const std::string& source) {
   if (!body) throw fail("no MOTION section");
   if (!open.empty()) throw fail("a joint's '{' is never closed");
   if (bvh.joints.empty()) throw fail("no joints");
+  if (bvh.channels == 0) throw fail("no channels: the hierarchy holds no motion");
   expect("Frames:");
   const double frames = number("the frame count");
   if (frames < 0 || frames != std::floor(frames) || frames > 1e7) throw fail("an invalid frame count");
