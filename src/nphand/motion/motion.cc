@@ -1,5 +1,7 @@
 #include "nphand/motion/motion.h"
 
+#include <cmath>
+
 #include "nphand/util/check.h"
 
 namespace nphand {
