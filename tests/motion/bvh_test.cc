@@ -5,29 +5,10 @@
 
 #include "nphand/util/check.h"
 #include "testing/testing.h"
+#include "tests/motion/random_motion.h"
 
 namespace nphand {
 namespace {
-
-// Random wrist orientations, articulations within the limits and wrist places.
-Motion RandomMotion(const HandModel& hand, int frames, double scale, uint64_t seed) {
-  Random random(seed);
-  Motion motion;
-  motion.hand = hand.handedness();
-  motion.fps = 30.0;
-  motion.scale = scale;
-  for (int f = 0; f < frames; ++f) {
-    MotionFrame frame;
-    frame.pose.handedness = hand.handedness();
-    frame.pose.camera_from_hand = Eigen::Quaterniond(random.Normal(), random.Normal(), random.Normal(), random.Normal())
-                                      .normalized()
-                                      .toRotationMatrix();
-    frame.pose.angles = RandomArticulation(random);
-    frame.wrist_camera = Eigen::Vector3d(random.Uniform(-0.2, 0.2), random.Uniform(-0.2, 0.2), random.Uniform(0.3, 0.8));
-    motion.frames.push_back(frame);
-  }
-  return motion;
-}
 
 double MaxKeypointDifference(const Keypoints3d& a, const Keypoints3d& b) {
   double worst = 0.0;
@@ -37,7 +18,7 @@ double MaxKeypointDifference(const Keypoints3d& a, const Keypoints3d& b) {
 
 TEST(BvhTest, ReadBackAndRunThroughForwardKinematicsItGivesTheKeypoints) {
   for (const HandModel* hand : {&testing::RightHand(), &testing::LeftHand()}) {
-    const Motion motion = RandomMotion(*hand, 40, 1.08, 5);
+    const Motion motion = testing::RandomMotion(hand->handedness(), 40, 30.0, 1.08, 5);
     const auto path = testing::ScratchDir() / "hand.bvh";
     WriteBvh(*hand, motion, path);
     const Bvh bvh = ReadBvh(path);

@@ -6,35 +6,17 @@
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
 #include "testing/testing.h"
+#include "tests/motion/random_motion.h"
 
 namespace nphand {
 namespace {
-
-Motion RandomMotion(Handedness side, int frames, double scale, uint64_t seed) {
-  Random random(seed);
-  Motion motion;
-  motion.hand = side;
-  motion.fps = 25.0;
-  motion.scale = scale;
-  for (int f = 0; f < frames; ++f) {
-    MotionFrame frame;
-    frame.pose.handedness = side;
-    frame.pose.camera_from_hand = Eigen::Quaterniond(random.Normal(), random.Normal(), random.Normal(), random.Normal())
-                                      .normalized()
-                                      .toRotationMatrix();
-    frame.pose.angles = RandomArticulation(random);
-    frame.wrist_camera = Eigen::Vector3d(random.Uniform(-0.2, 0.2), random.Uniform(-0.2, 0.2), random.Uniform(0.3, 0.8));
-    motion.frames.push_back(frame);
-  }
-  return motion;
-}
 
 std::vector<uint8_t> AssetBytes(Handedness side) { return ReadFileBytes(DefaultAssetDir() / AssetFileName(side)); }
 
 TEST(GltfMotionTest, TheAnimatedHandLoadsBackWithItsJointsFramesAndKeypoints) {
   for (const HandModel* hand : {&testing::RightHand(), &testing::LeftHand()}) {
     for (double scale : {1.0, 0.9}) {
-      const Motion motion = RandomMotion(hand->handedness(), 30, scale, 11);
+      const Motion motion = testing::RandomMotion(hand->handedness(), 30, 25.0, scale, 11);
       const auto path = testing::ScratchDir() / "hand.glb";
       WriteGltfMotion(*hand, AssetBytes(hand->handedness()), motion, path);
       const std::vector<uint8_t> bytes = ReadFileBytes(path);
@@ -61,7 +43,7 @@ TEST(GltfMotionTest, TheAnimatedHandLoadsBackWithItsJointsFramesAndKeypoints) {
 TEST(GltfMotionTest, TheSkinnedMeshFollowsTheJoints) {
   // Skinning the written file's mesh the glTF way (node transforms times inverse bind
   // matrices) puts the fingertip's vertices where the model's own skinning puts them.
-  const Motion motion = RandomMotion(Handedness::kRight, 1, 1.0, 3);
+  const Motion motion = testing::RandomMotion(Handedness::kRight, 1, 25.0, 1.0, 3);
   const std::vector<uint8_t> bytes = GltfMotionBytes(testing::RightHand(), AssetBytes(Handedness::kRight), motion);
   const GltfMotion read = ReadGltfMotion(bytes, "hand.glb");
   std::vector<Eigen::Vector3f> vertices;
@@ -75,7 +57,7 @@ TEST(GltfMotionTest, TheSkinnedMeshFollowsTheJoints) {
 }
 
 TEST(GltfMotionTest, WrongInputsAreRefusedByName) {
-  const Motion motion = RandomMotion(Handedness::kLeft, 2, 1.0, 1);
+  const Motion motion = testing::RandomMotion(Handedness::kLeft, 2, 25.0, 1.0, 1);
   EXPECT_THROW(GltfMotionBytes(testing::RightHand(), AssetBytes(Handedness::kRight), motion), Error);
   const std::vector<uint8_t> garbage(100, 3);
   try {
