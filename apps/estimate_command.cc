@@ -80,23 +80,28 @@ std::vector<NamedPath> Inputs(const EstimateCommandOptions& options, const Frame
   return inputs;
 }
 
-// The motion files of a run: one track per side, the side with more frames written.
+// The motion files of a run: every frame's estimate kept once, the side found in more
+// frames written as the track.
 class MotionOutputs {
  public:
   MotionOutputs(const EstimateCommandOptions& options, double fps, double scale)
-      : options_(options), right_(Handedness::kRight, fps, scale), left_(Handedness::kLeft, fps, scale) {}
+      : options_(options), fps_(fps), scale_(scale) {}
   bool wanted() const { return !options_.bvh.empty() || !options_.gltf.empty(); }
 
   void Add(const FrameResult* result) {
+    if (!wanted()) return;
     std::optional<MotionFrame> frame;
-    if (result != nullptr && result->detected()) frame = MotionFrame{result->pose, result->keypoints_camera[0]};
-    right_.Add(frame);
-    left_.Add(frame);
+    if (result != nullptr && result->detected()) {
+      frame = MotionFrame{result->pose, result->keypoints_camera[0]};
+      ++(result->pose.handedness == Handedness::kLeft ? lefts_ : rights_);
+    }
+    frames_.push_back(std::move(frame));
   }
 
   // Writes the files (atomically); throws nphand::Error when no frame had a hand.
   void Write(nlohmann::json* summary) const {
-    const MotionRecorder& track = left_.with_hand() > right_.with_hand() ? left_ : right_;
+    MotionRecorder track(lefts_ > rights_ ? Handedness::kLeft : Handedness::kRight, fps_, scale_);
+    for (const std::optional<MotionFrame>& frame : frames_) track.Add(frame);
     const Motion motion = track.Finish();
     const HandModel hand = HandModel::Load(motion.hand, options_.asset_dir);
     if (!options_.bvh.empty()) {
@@ -113,7 +118,9 @@ class MotionOutputs {
 
  private:
   const EstimateCommandOptions& options_;
-  MotionRecorder right_, left_;
+  double fps_, scale_;
+  std::vector<std::optional<MotionFrame>> frames_;
+  size_t lefts_ = 0, rights_ = 0;
 };
 
 }  // namespace
