@@ -173,7 +173,10 @@ bool EstimatorOptions::Check(std::string* why) const {
 }
 
 nlohmann::json RefinementJson(const EstimatorOptions& options) {
-  return options.refine ? ToJson(options.refinement) : nlohmann::json(false);
+  if (!options.refine) return false;
+  nlohmann::json j = ToJson(options.refinement);
+  j["both_turns"] = options.refine_both_turns;
+  return j;
 }
 
 void SetHandChoice(const std::string& text, EstimatorOptions* options) {
@@ -636,45 +639,74 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
   return true;
 }
 
-std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup, double* turn, FrameResult* result) {
+std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup, double* turn, int* crop, FrameResult* result) {
   const Candidate& best = lookup.best();
-  const HandCrop& query_crop = lookup.crops[best.turn_of];
+  *turn = best.turn;
+  *crop = best.turn_of;
+  if (!refiner_.has_value()) return std::nullopt;
   // Refinement: the best entry's pose moved until its silhouette agrees with the query's;
   // it then stands for the entry in what follows.
-  std::optional<EntryPlacement> refined;
-  if (refiner_.has_value()) {
-    const Clock::time_point t = Clock::now();
-    const EntryPlacement& lookup_place = PlacementOf(best.entry);
-    // While the track holds (the prior took part), the side's refined rotation of the frame
-    // before, in this entry's image plane.
-    const size_t side = result->hand == Handedness::kRight ? 0 : 1;
-    if (refined_[side].frame != result->frame) refined_before_[side] = refined_[side];
-    const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -best.turn) * refined_before_[side].rotation;
-    const bool track = result->prior_used && refined_before_[side].frame == result->frame - 1;
-    const Refinement r = refiner_->Refine(query_crop, EntryScene(best.entry), lookup_place.crop_from_image,
-                                          track ? &previous : nullptr);
-    result->refined = r.moved;
-    result->refine_objective = std::make_pair(r.objective_before, r.objective_after);
-    if (r.moved) {
-      refined = EntryPlacement{best.entry, 0, r.crop_from_image, hand_.KeypointsOf(r.scene.hand), r.scene.wrist_in_camera};
-      // The silhouette turned counter-clockwise in the crop stands for a hand turned the
-      // other way in the frame.
-      *turn = best.turn - r.turn;
-      result->pose.angles = r.scene.hand.angles;
-      result->pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), best.turn) * RotationOf(r);
+  const Clock::time_point t = Clock::now();
+  // While the track holds (the prior took part), the side's refined rotation of the frame
+  // before.
+  const size_t side = result->hand == Handedness::kRight ? 0 : 1;
+  if (refined_[side].frame != result->frame) refined_before_[side] = refined_[side];
+  const Eigen::Matrix3d& before = refined_before_[side].rotation;
+  const bool track = result->prior_used && refined_before_[side].frame == result->frame - 1;
+  struct Tried {
+    const Candidate* start;
+    Refinement r;
+    double score;  // the silhouette's disagreement, and the turn from the track's last rotation
+  };
+  auto attempt = [&](const Candidate& c) {
+    const cv::Matx23d start_map = PlacementOf(c.entry).crop_from_image;
+    // The track's last rotation in this entry's image plane.
+    const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -c.turn) * before;
+    Tried tried{&c, refiner_->Refine(lookup.crops[c.turn_of], EntryScene(c.entry), start_map, track ? &previous : nullptr), 0.0};
+    tried.score = tried.r.disagreement_after;
+    if (track) {
+      // However far from the track (the refinement's own pull ends 30 degrees from it).
+      const double angle = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), c.turn) * RotationOf(tried.r), before);
+      tried.score += options_.refinement.track * (angle / 90.0) * (angle / 90.0);
     }
-    refined_[side] = {result->pose.camera_from_hand, result->frame};
-    result->ms.refine = Ms(t, Clock::now());
+    return tried;
+  };
+  Tried chosen = attempt(best);
+  if (options_.refine_both_turns && lookup.crops.size() == 2) {
+    // The silhouette's ends look alike: the best of the other turn is refined too, and the
+    // silhouette and the track choose.
+    for (size_t i : lookup.order) {
+      if (lookup.hyp[i].turn_of == best.turn_of) continue;
+      Tried other = attempt(lookup.hyp[i]);
+      if (other.score < chosen.score) chosen = std::move(other);
+      break;
+    }
   }
+  const Candidate& c = *chosen.start;
+  const Refinement& r = chosen.r;
+  result->refined = r.moved || &c != &best;
+  result->refine_objective = std::make_pair(r.objective_before, r.objective_after);
+  std::optional<EntryPlacement> refined;
+  if (result->refined) {
+    refined = EntryPlacement{c.entry, 0, r.crop_from_image, hand_.KeypointsOf(r.scene.hand), r.scene.wrist_in_camera};
+    // The silhouette turned counter-clockwise in the crop stands for a hand turned the
+    // other way in the frame.
+    *turn = c.turn - r.turn;
+    *crop = c.turn_of;
+    result->pose.angles = r.scene.hand.angles;
+    result->pose.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), c.turn) * RotationOf(r);
+  }
+  refined_[side] = {result->pose.camera_from_hand, result->frame};
+  result->ms.refine = Ms(t, Clock::now());
   return refined;
 }
 
-void Estimator::Place(const Lookup& lookup, const EntryPlacement& entry, double turn, cv::Rect box, cv::Size frame,
+void Estimator::Place(const Lookup& lookup, int crop, const EntryPlacement& entry, double turn, cv::Rect box, cv::Size frame,
                       FrameResult* result) {
   // The entry rendered as the database saw it tells where its keypoints lie in its crop;
   // the query's crop maps them into the frame, and the two crops' scales give the distance.
   const Clock::time_point t = Clock::now();
-  const HandCrop& query_crop = lookup.crops[lookup.best().turn_of];
+  const HandCrop& query_crop = lookup.crops[crop];
   const cv::Rect roi = lookup.roi;
   const cv::Matx23d frame_from_crop = Invert(query_crop.crop_from_image);
   const double size = options_.hand_length_m / model_hand_length_;
@@ -718,9 +750,10 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   if (!Weigh(box, &lookup, &result)) return result;
   // The image-plane turn from the database's camera to the frame's; the refinement (if on)
   // may turn it further, and its pose then stands for the best entry's.
-  double turn = lookup.best().turn;
-  const std::optional<EntryPlacement> refined = Refine(lookup, &turn, &result);
-  Place(lookup, refined.has_value() ? *refined : PlacementOf(lookup.best().entry), turn, box, frame, &result);
+  double turn = 0.0;
+  int crop = 0;
+  const std::optional<EntryPlacement> refined = Refine(lookup, &turn, &crop, &result);
+  Place(lookup, crop, refined.has_value() ? *refined : PlacementOf(lookup.best().entry), turn, box, frame, &result);
   return result;
 }
 

@@ -89,6 +89,10 @@ struct EstimatorOptions {
   // from the refined pose.
   bool refine = false;
   RefineOptions refinement;
+  // Where both turns of the crop were searched (roll_ambiguity), the best hypothesis of each
+  // is refined, and the one whose silhouette agrees better, pulled towards the track's last
+  // rotation, is kept.
+  bool refine_both_turns = true;
   bool Check(std::string* why) const;
 };
 
@@ -208,12 +212,14 @@ class Estimator {
   // Hypotheses, observation weights, the prior, the carried hypotheses, the posteriors and
   // the top-N; false (with the reason) when nothing in the database is near.
   bool Weigh(cv::Rect box, Lookup* lookup, FrameResult* result);
-  // With refine: the best entry's pose refined against the crop (its placement, and the
-  // turn it adds), else nothing.
+  // With refine: the best entry's pose (or, with refine_both_turns, the other turn's best
+  // entry's) refined against its crop: the placement, the turn and which crop it was
+  // refined against, or nothing (the best entry as it is, its turn and crop).
   struct EntryPlacement;
-  std::optional<EntryPlacement> Refine(const Lookup& lookup, double* turn, FrameResult* result);
-  // Keypoints in the frame and in 3D, from `entry`'s render and crop turned by `turn`.
-  void Place(const Lookup& lookup, const EntryPlacement& entry, double turn, cv::Rect box, cv::Size frame,
+  std::optional<EntryPlacement> Refine(const Lookup& lookup, double* turn, int* crop, FrameResult* result);
+  // Keypoints in the frame and in 3D, from `entry`'s render and the query's crop `crop`,
+  // turned by `turn`.
+  void Place(const Lookup& lookup, int crop, const EntryPlacement& entry, double turn, cv::Rect box, cv::Size frame,
              FrameResult* result);
   // Estimate for a hand of side `side`: a left hand's mask is mirrored into the right-hand
   // database, and its result mirrored back.

@@ -66,6 +66,23 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
   // wrist, pulled towards the last frame's), the place alone, with the fingers too (in two
   // step sizes), other pulls, finer renders and more passes.
   around_default("refine", [&](EstimatorOptions& e) { e.refine = true; });
+  for (double ambiguity : {0.15, 0.3, 9.0}) {
+    std::ostringstream name;
+    name << "refine-turns" << ambiguity;
+    around_default(name.str(), [&](EstimatorOptions& e) {
+      e.refine = true;
+      e.roll_ambiguity = ambiguity;
+    });
+  }
+  around_default("refine-1turn-turns9", [&](EstimatorOptions& e) {
+    e.refine = true;
+    e.roll_ambiguity = 9.0;
+    e.refine_both_turns = false;
+  });
+  around_default("refine-one-turn", [&](EstimatorOptions& e) {
+    e.refine = true;
+    e.refine_both_turns = false;
+  });
   around_default("refine-place", [&](EstimatorOptions& e) {
     e.refine = true;
     e.refinement.move_wrist = false;
@@ -197,7 +214,9 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
           camera += (r.keypoints_camera[k] - (truth.wrist_in_camera + truth.keypoints[k])).norm();
         }
         score.joint_deg += joint / kNumDofs * 180.0 / std::numbers::pi;
-        score.wrist_deg += RotationAngleDeg(r.pose.camera_from_hand, truth.pose.camera_from_hand);
+        const double wrist = RotationAngleDeg(r.pose.camera_from_hand, truth.pose.camera_from_hand);
+        score.wrist_deg += wrist;
+        score.turned += wrist >= kTurnedDeg;
         score.keypoint_mm += 1000.0 * keypoint / kNumKeypoints;
         score.keypoint_px += px / kNumKeypoints;
         score.camera_mm += 1000.0 * camera / kNumKeypoints;
@@ -226,6 +245,7 @@ nlohmann::json ToJson(const std::vector<EstimatorScore>& scores) {
                     {"frames", s.frames},
                     {"detected", s.detected},
                     {"both_turns", s.both_turns},
+                    {"turned", s.turned},
                     {"joint_deg", s.joint_deg},
                     {"wrist_deg", s.wrist_deg},
                     {"keypoint_mm", s.keypoint_mm},
@@ -241,7 +261,7 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
   std::ostringstream out;
   out << std::left << std::setw(22) << "setting" << std::right << std::setw(10) << "detected" << std::setw(10)
       << "joint_deg" << std::setw(10) << "wrist_deg" << std::setw(12) << "keypoint_mm" << std::setw(12) << "keypoint_px"
-      << std::setw(11) << "camera_mm" << std::setw(8) << "jitter" << std::setw(8) << "ms" << std::setw(8) << "2turns" << "\n";
+      << std::setw(11) << "camera_mm" << std::setw(8) << "jitter" << std::setw(8) << "ms" << std::setw(8) << "2turns" << std::setw(8) << "turned" << "\n";
   out << std::fixed;
   for (const EstimatorScore& s : scores) {
     out << std::left << std::setw(22) << s.name << std::right << std::setw(10)
@@ -249,7 +269,7 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
         << s.joint_deg << std::setw(10) << s.wrist_deg << std::setprecision(1) << std::setw(12) << s.keypoint_mm
         << std::setw(12) << s.keypoint_px << std::setw(11) << s.camera_mm << std::setw(8) << s.jitter_mm
         << std::setprecision(2) << std::setw(8) << s.ms_median << std::setprecision(0) << std::setw(7)
-        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%\n";
+        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%" << std::setw(8) << s.turned << "\n";
   }
   return out.str();
 }

@@ -40,12 +40,17 @@ struct EstimatorStudyOptions {
   bool Check(std::string* why) const;
 };
 
+// A wrist this far from the truth is turned about 180 degrees: the wrist drawn at the
+// fingertips, a silhouette read end for end.
+inline constexpr double kTurnedDeg = 135.0;
+
 struct EstimatorScore {
   std::string name;
   nlohmann::json options;      // what differs from the base
   int frames = 0;
   int detected = 0;            // frames with an estimate
   int both_turns = 0;          // of which searched the half-turned crop too
+  int turned = 0;              // of which with the wrist turned about a half turn: at least kTurnedDeg from the truth
   double joint_deg = 0.0;      // mean absolute joint-angle error, mean over detected frames
   double wrist_deg = 0.0;      // wrist rotation error, mean
   double keypoint_mm = 0.0;    // mean 3D keypoint error about the wrist (the paper's joint-position measure)
