@@ -652,33 +652,30 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
   const size_t side = result->hand == Handedness::kRight ? 0 : 1;
   if (refined_[side].frame != result->frame) refined_before_[side] = refined_[side];
   const Eigen::Matrix3d& before = refined_before_[side].rotation;
-  const bool track = result->prior_used && refined_before_[side].frame == result->frame - 1;
+  const bool last = refined_before_[side].frame == result->frame - 1;
+  const bool track = result->prior_used && last;
   struct Tried {
     const Candidate* start;
     Refinement r;
-    double score;  // the silhouette's disagreement, and the turn from the track's last rotation
+    double from_last;  // degrees from the last frame's refined rotation (0 without one)
   };
   auto attempt = [&](const Candidate& c) {
     const cv::Matx23d start_map = PlacementOf(c.entry).crop_from_image;
     // The track's last rotation in this entry's image plane.
     const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -c.turn) * before;
     Tried tried{&c, refiner_->Refine(lookup.crops[c.turn_of], EntryScene(c.entry), start_map, track ? &previous : nullptr), 0.0};
-    tried.score = tried.r.disagreement_after;
-    if (track) {
-      // However far from the track (the refinement's own pull ends 30 degrees from it).
-      const double angle = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), c.turn) * RotationOf(tried.r), before);
-      tried.score += options_.refinement.track * (angle / 90.0) * (angle / 90.0);
-    }
+    if (last) tried.from_last = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), c.turn) * RotationOf(tried.r), before);
     return tried;
   };
   Tried chosen = attempt(best);
   if (options_.refine_both_turns && lookup.crops.size() == 2) {
-    // The silhouette's ends look alike: the best of the other turn is refined too, and the
-    // silhouette and the track choose.
+    // The silhouette's ends look alike: the best of the other turn is refined too, and
+    // replaces the lookup's best only if the silhouette agrees with it better and it is no
+    // farther from the last frame's rotation.
     for (size_t i : lookup.order) {
       if (lookup.hyp[i].turn_of == best.turn_of) continue;
       Tried other = attempt(lookup.hyp[i]);
-      if (other.score < chosen.score) chosen = std::move(other);
+      if (other.r.disagreement_after < chosen.r.disagreement_after && other.from_last <= chosen.from_last) chosen = std::move(other);
       break;
     }
   }

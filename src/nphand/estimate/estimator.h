@@ -89,9 +89,9 @@ struct EstimatorOptions {
   // from the refined pose.
   bool refine = false;
   RefineOptions refinement;
-  // Where both turns of the crop were searched (roll_ambiguity), the best hypothesis of each
-  // is refined, and the one whose silhouette agrees better, pulled towards the track's last
-  // rotation, is kept.
+  // Where both turns of the crop were searched (roll_ambiguity), the other turn's best
+  // hypothesis is refined too, and replaces the lookup's best if its silhouette agrees
+  // better and it lies no farther from the last frame's refined rotation.
   bool refine_both_turns = true;
   bool Check(std::string* why) const;
 };
@@ -149,9 +149,9 @@ struct FrameResult {
   double nearest_distance = 0.0;               // the best neighbour's feature distance (if searched)
   double effective_samples = 0.0;              // 1 / sum w^2 over the hypotheses
   double confidence = 0.0;                     // the posterior mass near the estimate, 0..1
-  // With refine: whether the refinement moved the pose, and its objective (silhouette
-  // disagreement, 1 - IoU, plus the pulls towards the start and the last frame's rotation)
-  // before and after.
+  // With refine: whether the refinement moved the pose (or kept the other turn's best
+  // entry), and the kept refinement's objective (silhouette disagreement, 1 - IoU, plus the
+  // pulls towards the start and the last frame's rotation) before and after.
   bool refined = false;
   std::optional<std::pair<double, double>> refine_objective;
   StageMilliseconds ms;
