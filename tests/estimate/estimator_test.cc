@@ -493,8 +493,7 @@ TEST_F(EstimatorTest, RefiningBothTurnsLetsTheSilhouetteAndTheTrackChoose) {
   EstimatorOptions both = one;
   both.refine_both_turns = true;
   Estimator a(*db_, *index_, RightHand(), one), b(*db_, *index_, RightHand(), both);
-  SequenceOptions options = SmallSequence(40);
-  Sequence sequence(RightHand(), options);
+  Sequence sequence(RightHand(), SmallSequence(40));
   double wrist[2] = {0.0, 0.0};
   int frames = 0, differ = 0, turned[2] = {0, 0};
   for (int i = 0; i < sequence.size(); ++i) {
