@@ -59,6 +59,21 @@ def test_a_rendered_frame_round_trip(hand, tiny, frames):
         assert result.ms > 0
 
 
+def test_smoothing_is_on_by_default_and_can_be_turned_off(hand, tiny, frames):
+    db, index = tiny
+    smooth = nphand.Estimator(db, index, hand, k=40, faces=False)
+    raw = nphand.Estimator(db, index, hand, k=40, faces=False, smooth=False)
+    steps = []
+    for frame in frames:
+        a = smooth.process(frame["rgb"], frame["time_s"])
+        b = raw.process(frame["rgb"], frame["time_s"])
+        assert a.detected and b.detected
+        steps.append(np.abs(a.keypoints_3d - b.keypoints_3d).max())
+    # The first frame of a track is as it comes; later ones are pulled towards the last.
+    assert steps[0] < 1e-12
+    assert max(steps[1:]) > 1e-6
+
+
 def test_errors_are_exceptions_with_the_clis_message(tmp_path):
     bad = tmp_path / "bad.db"
     bad.write_bytes(b"garbage")

@@ -164,7 +164,7 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the side's memory must be within [0, 1) and its switching margin within [0, 10)";
   } else if (learn_interval < 1) {
     *why = "the learning interval must be at least 1 frame";
-  } else if (!skin.Check(why) || !forearm.Check(why) || !refinement.Check(why)) {
+  } else if (!skin.Check(why) || !forearm.Check(why) || !refinement.Check(why) || !smoothing.Check(why)) {
     return false;
   } else {
     return true;
@@ -177,6 +177,13 @@ nlohmann::json RefinementJson(const EstimatorOptions& options) {
   nlohmann::json j = ToJson(options.refinement);
   j["both_turns"] = options.refine_both_turns;
   return j;
+}
+
+nlohmann::json SmoothingJson(const EstimatorOptions& options) {
+  if (!options.smooth) return false;
+  return {{"min_cutoff_hz", options.smoothing.min_cutoff_hz},
+          {"beta", options.smoothing.beta},
+          {"derivative_cutoff_hz", options.smoothing.derivative_cutoff_hz}};
 }
 
 void SetHandChoice(const std::string& text, EstimatorOptions* options) {
@@ -197,7 +204,17 @@ double ModelHandLength(const Database& db) {
 }
 
 Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel& hand, const EstimatorOptions& options)
-    : db_(db), index_(index), hand_(hand), options_(options), segmenter_(options.skin), renderer_(hand), side_(options.hand) {
+    : db_(db),
+      index_(index),
+      hand_(hand),
+      options_(options),
+      segmenter_(options.skin),
+      renderer_(hand),
+      smooth_wrist_(options.smoothing),
+      smooth_image_(options.smoothing),
+      smooth_angles_(options.smoothing),
+      smooth_rotation_(options.smoothing),
+      side_(options.hand) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "estimator: ", why);
   NPHAND_THROW_CHECK(db.header().value("hand", "") == "right" && hand.handedness() == Handedness::kRight,
@@ -258,6 +275,7 @@ void Estimator::Reset() {
   side_frame_ = -1;
   refined_ = {};
   refined_before_ = {};
+  for (OneEuroFilter* f : {&smooth_wrist_, &smooth_image_, &smooth_angles_, &smooth_rotation_}) f->Reset();
 }
 
 const Intrinsics& Estimator::intrinsics_for(cv::Size frame) const {
@@ -316,6 +334,54 @@ RenderedImages Estimator::RenderEntry(uint32_t entry) {
 }
 
 FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
+  FrameResult result = Detect(bgr, time_s);
+  Smooth(bgr.cols, &result);
+  return result;
+}
+
+FrameResult Estimator::ProcessMask(const cv::Mat& mask, double time_s) {
+  FrameResult result = DetectMask(mask, time_s);
+  Smooth(mask.cols, &result);
+  return result;
+}
+
+void Estimator::Smooth(int width, FrameResult* r) {
+  if (!options_.smooth) return;
+  if (!r->detected() || r->hand != smoothed_side_) {
+    for (OneEuroFilter* f : {&smooth_wrist_, &smooth_image_, &smooth_angles_, &smooth_rotation_}) f->Reset();
+  }
+  if (!r->detected()) return;
+  smoothed_side_ = r->hand;
+  // The pose is smoothed as the right hand the database holds, and its keypoints made from
+  // it, so that they stay a hand's and agree with the angles and the rotation.
+  const bool left = r->hand == Handedness::kLeft;
+  if (left) MirrorResult(width, r);
+  const double length = options_.hand_length_m;
+  Eigen::VectorXd wrist(4), image(2 * kNumKeypoints), angles(kNumDofs);
+  wrist << r->keypoints_camera[0], r->depth_m;
+  for (int k = 0; k < kNumKeypoints; ++k) image.segment<2>(2 * k) = r->keypoints_2d[k];
+  for (int j = 0; j < kNumDofs; ++j) angles[j] = r->pose.angles[j];
+  wrist = smooth_wrist_.Filter(wrist, length, r->time_s);
+  image = smooth_image_.Filter(image, std::max(1.0, std::hypot(r->box.width, r->box.height)), r->time_s);
+  angles = smooth_angles_.Filter(angles, 1.0, r->time_s);
+  // The rotation as a quaternion on the last one's side of the sphere.
+  Eigen::Quaterniond q(r->pose.camera_from_hand);
+  if (q.coeffs().dot(last_quaternion_.coeffs()) < 0.0) q.coeffs() = -q.coeffs();
+  last_quaternion_ = Eigen::Quaterniond(Eigen::Vector4d(smooth_rotation_.Filter(q.coeffs(), 1.0, r->time_s))).normalized();
+  r->pose.camera_from_hand = last_quaternion_.toRotationMatrix();
+  for (int j = 0; j < kNumDofs; ++j) r->pose.angles[j] = angles[j];
+  const Keypoints3d keypoints = hand_.KeypointsOf(r->pose);
+  const double size = length / model_hand_length_;
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    r->keypoints_hand[k] = size * keypoints[k];
+    r->keypoints_camera[k] = wrist.head<3>() + r->keypoints_hand[k];
+    r->keypoints_2d[k] = image.segment<2>(2 * k);
+  }
+  r->depth_m = wrist[3];
+  if (left) MirrorResult(width, r);
+}
+
+FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {
   const Clock::time_point start = Clock::now();
   FrameResult result;
   result.frame = frame_++;
@@ -388,7 +454,7 @@ FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
   return result;
 }
 
-FrameResult Estimator::ProcessMask(const cv::Mat& mask, double time_s) {
+FrameResult Estimator::DetectMask(const cv::Mat& mask, double time_s) {
   NPHAND_THROW_CHECK(!mask.empty() && mask.type() == CV_8UC1, "estimator: a hand mask must be a non-empty 8-bit single-channel image");
   const Clock::time_point start = Clock::now();
   FrameResult result;

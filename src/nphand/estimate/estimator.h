@@ -24,6 +24,7 @@
 #include "nphand/render/camera.h"
 #include "nphand/render/renderer.h"
 #include "nphand/refine/refiner.h"
+#include "nphand/estimate/smoother.h"
 #include "nphand/scene/grasp.h"
 #include "nphand/segment/forearm.h"
 #include "nphand/segment/skin.h"
@@ -93,12 +94,18 @@ struct EstimatorOptions {
   // hypothesis is refined too, and replaces the lookup's best if its silhouette agrees
   // better and it lies no farther from the last frame's refined rotation.
   bool refine_both_turns = true;
+  // The track's estimates smoothed over time (estimate/smoother.h): keypoints, joint angles
+  // and the wrist's rotation, each frame's pulled towards the last's by a One Euro filter.
+  bool smooth = true;
+  SmoothOptions smoothing;
   bool Check(std::string* why) const;
 };
 
 // The refinement's settings (refine/refiner.h's ToJson) when `options` refine, else false:
 // how reports say whether and how a run refined.
 nlohmann::json RefinementJson(const EstimatorOptions& options);
+// The same for the smoothing: its settings, or false.
+nlohmann::json SmoothingJson(const EstimatorOptions& options);
 
 // Sets `options`' hand from "right", "left" or "auto" (hand_auto, starting right); throws
 // nphand::Error for anything else.
@@ -198,6 +205,14 @@ class Estimator {
   RenderedImages RenderEntry(uint32_t entry);
 
  private:
+  // Process and ProcessMask before smoothing.
+  FrameResult Detect(const cv::Mat& bgr, double time_s);
+  FrameResult DetectMask(const cv::Mat& mask, double time_s);
+  // With smooth: `r` (of a frame `width` pixels wide) filtered with the track's last
+  // estimates: the joint angles, the rotation, the wrist's place and the image keypoints,
+  // the 3D keypoints then made from them (a frame without the hand, or of the other side,
+  // starts the filters afresh).
+  void Smooth(int width, FrameResult* r);
   // Everything after the hand's mask: describe, search, weigh, refine, place. `hand_mask` is
   // frame-sized, `box` its pixels' bounds; `result` comes with frame, time and segmentation
   // time filled in. A region unlike any view leaves the carried hypotheses as they were
@@ -279,6 +294,9 @@ class Estimator {
   std::array<Refined, 2> refined_before_;  // by side: the latest of an earlier frame than refined_'s
   std::vector<WeightedPose> carried_;
   std::optional<cv::Point2d> last_centre_;
+  OneEuroFilter smooth_wrist_, smooth_image_, smooth_angles_, smooth_rotation_;
+  Handedness smoothed_side_ = Handedness::kRight;
+  Eigen::Quaterniond last_quaternion_ = Eigen::Quaterniond::Identity();
   Handedness side_ = Handedness::kRight;  // the track's side
   double side_evidence_ = 0.0;            // hand_auto: for side_ over the other (decaying sum)
   int side_frame_ = -1;                   // hand_auto: the frame last weighed (-1: none yet in this track)

@@ -1,6 +1,7 @@
 #include "nphand/eval/estimator_study.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iomanip>
 #include <numbers>
@@ -83,6 +84,19 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     e.refine = true;
     e.refine_both_turns = false;
   });
+  // Smoothing over time (estimate/smoother.h): the One Euro filter's cutoff at rest and its
+  // rise with speed.
+  for (double cutoff : {0.5, 1.0, 2.0, 4.0}) {
+    for (double beta : {0.5, 2.0, 5.0}) {
+      std::ostringstream name;
+      name << "smooth-c" << cutoff << "-b" << beta;
+      around_default(name.str(), [&](EstimatorOptions& e) {
+        e.smooth = true;
+        e.smoothing.min_cutoff_hz = cutoff;
+        e.smoothing.beta = beta;
+      });
+    }
+  }
   around_default("refine-place", [&](EstimatorOptions& e) {
     e.refine = true;
     e.refinement.move_wrist = false;
@@ -183,7 +197,8 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     score.options = {{"k", e.k},           {"observation", ToString(e.observation)}, {"sigma_y", e.sigma_y},
                      {"prior", ToString(e.prior)}, {"sigma_x", e.sigma_x}, {"prior_share", e.prior_share},
                      {"carried", e.carried},        {"roll_ambiguity", e.roll_ambiguity},
-                     {"refine", RefinementJson(e)}};
+                     {"refine", RefinementJson(e)},
+                     {"smooth", SmoothingJson(e)}};
     std::vector<double> ms;
     RunJitter jitter;
     std::vector<Keypoints3d> run;  // the keypoints of the current run of detected frames
@@ -191,10 +206,14 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
       jitter.Add(run);
       run.clear();
     };
+    // Per shift of the estimate behind the truth (frames): the summed keypoint error and its count.
+    std::array<double, kMaxLag + 1> lag_error{};
+    std::array<int, kMaxLag + 1> lag_count{};
     for (const std::vector<SequenceFrame>& frames : sequences) {
       estimator.Reset();
       close_run();
-      for (const SequenceFrame& truth : frames) {
+      for (size_t t = 0; t < frames.size(); ++t) {
+        const SequenceFrame& truth = frames[t];
         const FrameResult r = options.masks ? estimator.ProcessMask(truth.labels == static_cast<int>(PixelLabel::kHand), truth.time_s)
                                             : estimator.Process(truth.rgb, truth.time_s);
         ++score.frames;
@@ -205,6 +224,12 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
         }
         run.push_back(r.keypoints_hand);
         ++score.detected;
+        for (size_t lag = 0; lag <= std::min<size_t>(kMaxLag, t); ++lag) {
+          double error = 0.0;
+          for (int k = 0; k < kNumKeypoints; ++k) error += (r.keypoints_hand[k] - frames[t - lag].keypoints[k]).norm();
+          lag_error[lag] += error;
+          ++lag_count[lag];
+        }
         score.both_turns += r.both_turns;
         double joint = 0.0, keypoint = 0.0, px = 0.0, camera = 0.0;
         for (int d = 0; d < kNumDofs; ++d) joint += std::abs(r.pose.angles[d] - truth.pose.angles[d]);
@@ -229,6 +254,15 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     }
     close_run();
     score.jitter_mm = 1000.0 * jitter.mean();
+    double least = 1e300;
+    for (int lag = 0; lag <= kMaxLag; ++lag) {
+      if (lag_count[lag] == 0) continue;
+      const double mean = lag_error[lag] / lag_count[lag];
+      if (mean < least) {
+        least = mean;
+        score.lag_frames = lag;
+      }
+    }
     score.ms_median = Median(ms);
     scores.push_back(score);
     line.Update(scores.size());
@@ -252,6 +286,7 @@ nlohmann::json ToJson(const std::vector<EstimatorScore>& scores) {
                     {"keypoint_px", s.keypoint_px},
                     {"camera_mm", s.camera_mm},
                     {"jitter_mm", s.jitter_mm},
+                    {"lag_frames", s.lag_frames},
                     {"ms_median", s.ms_median}});
   }
   return rows;
@@ -261,7 +296,7 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
   std::ostringstream out;
   out << std::left << std::setw(22) << "setting" << std::right << std::setw(10) << "detected" << std::setw(10)
       << "joint_deg" << std::setw(10) << "wrist_deg" << std::setw(12) << "keypoint_mm" << std::setw(12) << "keypoint_px"
-      << std::setw(11) << "camera_mm" << std::setw(8) << "jitter" << std::setw(8) << "ms" << std::setw(8) << "2turns" << std::setw(8) << "turned" << "\n";
+      << std::setw(11) << "camera_mm" << std::setw(8) << "jitter" << std::setw(8) << "ms" << std::setw(8) << "2turns" << std::setw(8) << "turned" << std::setw(5) << "lag" << "\n";
   out << std::fixed;
   for (const EstimatorScore& s : scores) {
     out << std::left << std::setw(22) << s.name << std::right << std::setw(10)
@@ -269,7 +304,7 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
         << s.joint_deg << std::setw(10) << s.wrist_deg << std::setprecision(1) << std::setw(12) << s.keypoint_mm
         << std::setw(12) << s.keypoint_px << std::setw(11) << s.camera_mm << std::setw(8) << s.jitter_mm
         << std::setprecision(2) << std::setw(8) << s.ms_median << std::setprecision(0) << std::setw(7)
-        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%" << std::setw(8) << s.turned << "\n";
+        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%" << std::setw(8) << s.turned << std::setw(5) << s.lag_frames << "\n";
   }
   return out.str();
 }

@@ -109,7 +109,8 @@ class EstimatorMethod : public PoseMethod {
     return {{"index", backend_},         {"k", o.k},           {"observation", ToString(o.observation)},
             {"sigma_y", o.sigma_y},      {"prior", ToString(o.prior)}, {"sigma_x", o.sigma_x},
             {"carried", o.carried},      {"input", from_rgb_ ? "rgb" : "mask"},
-            {"refine", RefinementJson(o)}};
+            {"refine", RefinementJson(o)},
+            {"smooth", SmoothingJson(o)}};
   }
 
  private:

@@ -41,7 +41,7 @@ nlohmann::json ToJson(const MethodScore& s) {
 
 std::string FormatScores(const std::vector<MethodScore>& scores, const std::string& sequence) {
   std::ostringstream out;
-  out << std::left << std::setw(7) << "alpha" << std::setw(16) << "method" << std::right << std::setw(10) << "detected"
+  out << std::left << std::setw(7) << "alpha" << std::setw(26) << "method" << std::right << std::setw(10) << "detected"
       << std::setw(9) << "no-hand"
       << std::setw(8) << "pose" << std::setw(7) << "/NN" << std::setw(9) << "kp_mm" << std::setw(7) << "/NN" << std::setw(8)
       << "PA_mm" << std::setw(7) << "<20mm" << std::setw(7) << "AUC" << std::setw(7) << "px" << std::setw(8) << "wrist"
@@ -56,7 +56,7 @@ std::string FormatScores(const std::vector<MethodScore>& scores, const std::stri
   };
   for (const MethodScore& s : scores) {
     if (s.sequence != sequence) continue;
-    out << std::left << std::setprecision(1) << std::setw(7) << s.alpha << std::setw(16) << s.method << std::right
+    out << std::left << std::setprecision(1) << std::setw(7) << s.alpha << std::setw(26) << s.method << std::right
         << std::setw(10) << (std::to_string(s.detected) + "/" + std::to_string(s.frames)) << std::setw(9)
         << (s.no_hand_frames > 0 ? std::to_string(s.false_detections) + "/" + std::to_string(s.no_hand_frames) : "-");
     cell(s.pose_error, 8, 3);

@@ -355,8 +355,11 @@ PoseStudyResult RunPoseStudy(PoseStudyPart part, const Database& db, const KnnIn
       progress);
   result.sequences = DescribeSequences(sequences);
 
+  // The paper's PNP: each frame's estimate as it comes, unsmoothed (nphand's default,
+  // smoothed, has rows of its own).
   EstimatorOptions pnp = options_base;
   pnp.hand_length_m = ModelHandLength(db);
+  pnp.smooth = false;
   EstimatorOptions nn_feature = pnp;
   nn_feature.prior = PriorCombination::kNone;
   std::unique_ptr<KnnIndex> exact;
@@ -367,10 +370,17 @@ PoseStudyResult RunPoseStudy(PoseStudyPart part, const Database& db, const KnnIn
   }
   EstimatorOptions refined = pnp;
   refined.refine = true;
+  EstimatorOptions smoothed = pnp;
+  smoothed.smooth = true;
+  EstimatorOptions both = refined;
+  both.smooth = true;
   methods.push_back(MakeEstimatorMethod("PNP", db, index, hand, pnp, false));
   methods.push_back(MakeEstimatorMethod("PNP + refine", db, index, hand, refined, false));
+  methods.push_back(MakeEstimatorMethod("PNP + smooth", db, index, hand, smoothed, false));
   methods.push_back(MakeEstimatorMethod("PNP RGB", db, index, hand, pnp, true));
   methods.push_back(MakeEstimatorMethod("PNP RGB + refine", db, index, hand, refined, true));
+  methods.push_back(MakeEstimatorMethod("PNP RGB + smooth", db, index, hand, smoothed, true));
+  methods.push_back(MakeEstimatorMethod("PNP RGB + refine + smooth", db, index, hand, both, true));
   methods.push_back(MakeEstimatorMethod("NN feature", db, index, hand, nn_feature, false));
   methods.push_back(MakeNearestPoseMethod(db));
   if (part != PoseStudyPart::kRobustness) {
