@@ -276,6 +276,8 @@ void Estimator::Reset() {
   refined_ = {};
   refined_before_ = {};
   for (OneEuroFilter* f : {&smooth_wrist_, &smooth_image_, &smooth_angles_, &smooth_rotation_}) f->Reset();
+  smoothed_side_ = options_.hand;
+  last_quaternion_ = Eigen::Quaterniond::Identity();
 }
 
 const Intrinsics& Estimator::intrinsics_for(cv::Size frame) const {
