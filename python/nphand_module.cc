@@ -336,8 +336,8 @@ PYBIND11_MODULE(nphand, m) {
              return std::make_unique<Estimate>(std::move(db), std::move(index), std::move(hand), options);
            }),
            py::arg("db"), py::arg("index"), py::arg("hand_model"), py::arg("hand") = "right", py::arg("k") = 500,
-           py::arg("refine") = false, py::arg("smooth") = true, py::arg("hand_length") = 0.18, py::arg("fov") = 60.0, py::arg("focal") = 0.0,
-           py::arg("faces") = true)
+           py::arg("refine") = false, py::arg("smooth") = true, py::arg("hand_length") = 0.18, py::arg("fov") = 60.0,
+           py::arg("focal") = 0.0, py::arg("faces") = true)
       .def("process", &Estimate::Process, py::arg("frame"), py::arg("time_s") = py::none(),
            "Estimates the hand in the next frame (H x W x 3 uint8 BGR); time_s defaults to 1/30 s after the last")
       .def("reset", &Estimate::Reset, "Forgets the track (a new video)");

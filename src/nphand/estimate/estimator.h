@@ -19,12 +19,12 @@
 #include <opencv2/core.hpp>
 
 #include "nphand/db/database.h"
+#include "nphand/estimate/smoother.h"
 #include "nphand/index/knn_index.h"
 #include "nphand/model/hand_model.h"
 #include "nphand/render/camera.h"
 #include "nphand/render/renderer.h"
 #include "nphand/refine/refiner.h"
-#include "nphand/estimate/smoother.h"
 #include "nphand/scene/grasp.h"
 #include "nphand/segment/forearm.h"
 #include "nphand/segment/skin.h"
@@ -94,8 +94,9 @@ struct EstimatorOptions {
   // hypothesis is refined too, and replaces the lookup's best if its silhouette agrees
   // better and it lies no farther from the last frame's refined rotation.
   bool refine_both_turns = true;
-  // The track's estimates smoothed over time (estimate/smoother.h): keypoints, joint angles
-  // and the wrist's rotation, each frame's pulled towards the last's by a One Euro filter.
+  // The track's estimates smoothed over time (estimate/smoother.h): the joint angles, the
+  // rotation, the wrist's place and the image keypoints, each frame's pulled towards the
+  // last's by a One Euro filter; the 3D keypoints are the smoothed pose's.
   bool smooth = true;
   SmoothOptions smoothing;
   bool Check(std::string* why) const;
