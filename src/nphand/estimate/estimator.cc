@@ -275,9 +275,8 @@ void Estimator::Reset() {
   side_frame_ = -1;
   refined_ = {};
   refined_before_ = {};
-  for (OneEuroFilter* f : {&smooth_wrist_, &smooth_image_, &smooth_angles_, &smooth_rotation_}) f->Reset();
+  ResetSmoothing();
   smoothed_side_ = options_.hand;
-  last_quaternion_ = Eigen::Quaterniond::Identity();
 }
 
 const Intrinsics& Estimator::intrinsics_for(cv::Size frame) const {
@@ -337,27 +336,25 @@ RenderedImages Estimator::RenderEntry(uint32_t entry) {
 
 FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
   FrameResult result = Detect(bgr, time_s);
-  Smooth(bgr.cols, &result);
+  Smooth(&result);
   return result;
 }
 
 FrameResult Estimator::ProcessMask(const cv::Mat& mask, double time_s) {
   FrameResult result = DetectMask(mask, time_s);
-  Smooth(mask.cols, &result);
+  Smooth(&result);
   return result;
 }
 
-void Estimator::Smooth(int width, FrameResult* r) {
+void Estimator::ResetSmoothing() {
+  for (OneEuroFilter* f : {&smooth_wrist_, &smooth_image_, &smooth_angles_, &smooth_rotation_}) f->Reset();
+}
+
+void Estimator::Smooth(FrameResult* r) {
   if (!options_.smooth) return;
-  if (!r->detected() || r->hand != smoothed_side_) {
-    for (OneEuroFilter* f : {&smooth_wrist_, &smooth_image_, &smooth_angles_, &smooth_rotation_}) f->Reset();
-  }
+  if (!r->detected() || r->hand != smoothed_side_) ResetSmoothing();
   if (!r->detected()) return;
   smoothed_side_ = r->hand;
-  // The pose is smoothed as the right hand the database holds, and its keypoints made from
-  // it, so that they stay a hand's and agree with the angles and the rotation.
-  const bool left = r->hand == Handedness::kLeft;
-  if (left) MirrorResult(width, r);
   const double length = options_.hand_length_m;
   Eigen::VectorXd wrist(4), image(2 * kNumKeypoints), angles(kNumDofs);
   wrist << r->keypoints_camera[0], r->depth_m;
@@ -366,21 +363,26 @@ void Estimator::Smooth(int width, FrameResult* r) {
   wrist = smooth_wrist_.Filter(wrist, length, r->time_s);
   image = smooth_image_.Filter(image, std::max(1.0, std::hypot(r->box.width, r->box.height)), r->time_s);
   angles = smooth_angles_.Filter(angles, 1.0, r->time_s);
-  // The rotation as a quaternion on the last one's side of the sphere.
+  // The rotation as a quaternion on the last filtered one's side of the sphere.
   Eigen::Quaterniond q(r->pose.camera_from_hand);
-  if (q.coeffs().dot(last_quaternion_.coeffs()) < 0.0) q.coeffs() = -q.coeffs();
-  last_quaternion_ = Eigen::Quaterniond(Eigen::Vector4d(smooth_rotation_.Filter(q.coeffs(), 1.0, r->time_s))).normalized();
-  r->pose.camera_from_hand = last_quaternion_.toRotationMatrix();
+  if (const Eigen::VectorXd* last = smooth_rotation_.last(); last != nullptr && q.coeffs().dot(*last) < 0.0) {
+    q.coeffs() = -q.coeffs();
+  }
+  r->pose.camera_from_hand =
+      Eigen::Quaterniond(Eigen::Vector4d(smooth_rotation_.Filter(q.coeffs(), 1.0, r->time_s))).normalized().toRotationMatrix();
   for (int j = 0; j < kNumDofs; ++j) r->pose.angles[j] = angles[j];
-  const Keypoints3d keypoints = hand_.KeypointsOf(r->pose);
+  // The keypoints are the smoothed pose's, so that they stay a hand's and agree with the
+  // angles and the rotation: a left hand's are the mirrored right hand's the database holds.
+  const bool left = r->hand == Handedness::kLeft;
+  Keypoints3d keypoints = hand_.KeypointsOf(left ? MirrorPose(r->pose) : r->pose);
   const double size = length / model_hand_length_;
   for (int k = 0; k < kNumKeypoints; ++k) {
+    if (left) keypoints[k].x() = -keypoints[k].x();
     r->keypoints_hand[k] = size * keypoints[k];
     r->keypoints_camera[k] = wrist.head<3>() + r->keypoints_hand[k];
     r->keypoints_2d[k] = image.segment<2>(2 * k);
   }
   r->depth_m = wrist[3];
-  if (left) MirrorResult(width, r);
 }
 
 FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {

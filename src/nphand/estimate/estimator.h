@@ -209,11 +209,11 @@ class Estimator {
   // Process and ProcessMask before smoothing.
   FrameResult Detect(const cv::Mat& bgr, double time_s);
   FrameResult DetectMask(const cv::Mat& mask, double time_s);
-  // With smooth: `r` (of a frame `width` pixels wide) filtered with the track's last
-  // estimates: the joint angles, the rotation, the wrist's place and the image keypoints,
-  // the 3D keypoints then made from them (a frame without the hand, or of the other side,
-  // starts the filters afresh).
-  void Smooth(int width, FrameResult* r);
+  // With smooth: `r` filtered with the track's last estimates: the joint angles, the
+  // rotation, the wrist's place and the image keypoints, the 3D keypoints then made from
+  // them (a frame without the hand, or of the other side, starts the filters afresh).
+  void Smooth(FrameResult* r);
+  void ResetSmoothing();
   // Everything after the hand's mask: describe, search, weigh, refine, place. `hand_mask` is
   // frame-sized, `box` its pixels' bounds; `result` comes with frame, time and segmentation
   // time filled in. A region unlike any view leaves the carried hypotheses as they were
@@ -297,7 +297,6 @@ class Estimator {
   std::optional<cv::Point2d> last_centre_;
   OneEuroFilter smooth_wrist_, smooth_image_, smooth_angles_, smooth_rotation_;
   Handedness smoothed_side_ = Handedness::kRight;
-  Eigen::Quaterniond last_quaternion_ = Eigen::Quaterniond::Identity();
   Handedness side_ = Handedness::kRight;  // the track's side
   double side_evidence_ = 0.0;            // hand_auto: for side_ over the other (decaying sum)
   int side_frame_ = -1;                   // hand_auto: the frame last weighed (-1: none yet in this track)

@@ -30,6 +30,8 @@ class OneEuroFilter {
   // are. Throws nphand::Error for a scale that is not positive.
   Eigen::VectorXd Filter(const Eigen::VectorXd& x, double scale, double time_s);
   void Reset() { last_.reset(); }
+  // The last filtered value, if any since the last start.
+  const Eigen::VectorXd* last() const { return last_.has_value() ? &last_->x : nullptr; }
 
  private:
   struct State {

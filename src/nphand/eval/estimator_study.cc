@@ -206,7 +206,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
       jitter.Add(run);
       run.clear();
     };
-    // Per shift of the estimate behind the truth (frames): the summed keypoint error and its count.
+    // Per shift of the estimate behind the truth (frames): the summed keypoint errors and their count.
     std::array<double, kMaxLag + 1> lag_error{};
     std::array<int, kMaxLag + 1> lag_count{};
     for (const std::vector<SequenceFrame>& frames : sequences) {
@@ -225,9 +225,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
         run.push_back(r.keypoints_hand);
         ++score.detected;
         for (size_t lag = 0; lag <= std::min<size_t>(kMaxLag, t); ++lag) {
-          double error = 0.0;
-          for (int k = 0; k < kNumKeypoints; ++k) error += (r.keypoints_hand[k] - frames[t - lag].keypoints[k]).norm();
-          lag_error[lag] += error;
+          lag_error[lag] += RootRelativeError(r.keypoints_hand, frames[t - lag].keypoints);
           ++lag_count[lag];
         }
         score.both_turns += r.both_turns;

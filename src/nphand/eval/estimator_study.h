@@ -43,6 +43,7 @@ struct EstimatorStudyOptions {
 // A wrist this far from the truth is turned about 180 degrees: the wrist drawn at the
 // fingertips, a silhouette read end for end.
 inline constexpr double kTurnedDeg = 135.0;
+// The estimate's lag behind the truth is sought among shifts of 0..kMaxLag frames.
 inline constexpr int kMaxLag = 8;
 
 struct EstimatorScore {
