@@ -205,6 +205,47 @@ TEST(SkinTest, AFaceFoundIsFollowedBetweenLooks) {
   EXPECT_EQ(gone.faces[0], at);
 }
 
+// A hand held in front of a face, its forearm coming in from the frame's edge (the demo's
+// opening frames): the head's skin that the hand's outline parts from the face stays skin, in
+// one region with the fingers and the arm; the face's own skin is set aside all the same.
+TEST(SkinTest, AHandInFrontOfAFaceKeepsWhatItsOutlinePartsFromTheFace) {
+  SequenceOptions options;
+  options.frames = 120;
+  options.grasp = 1;
+  options.object_scale = 0.8;
+  options.background = BackgroundKind::kClutter;
+  options.face = true;
+  options.seed = 11;
+  Sequence sequence(testing::RightHand(), options);
+  const SequenceFrame frame = sequence.Render(2);
+  const cv::Mat body = (frame.labels == static_cast<int>(PixelLabel::kHand)) |
+                       (frame.labels == static_cast<int>(PixelLabel::kForearm));
+  // The share of the hand's and arm's pixels in the region holding most of them.
+  auto covered = [&](bool part_faces) {
+    SkinOptions skin;
+    skin.part_faces = part_faces;
+    SkinSegmenter segmenter(skin);
+    const SkinSegmentation s = segmenter.Segment(frame.rgb);
+    EXPECT_EQ(s.faces.size(), 1u);
+    double best = 0.0;
+    for (const SkinRegion& region : s.regions) {
+      const cv::Mat mask = s.Mask({region.label}, cv::Rect(cv::Point(0, 0), s.frame));
+      best = std::max(best, static_cast<double>(cv::countNonZero(mask & body)) / cv::countNonZero(body));
+      // No region holds the face's middle.
+      if (!s.faces.empty()) {
+        const cv::Rect face = s.faces[0];
+        const cv::Rect middle(face.x + face.width / 4, face.y + face.height / 4, face.width / 2, face.height / 2);
+        const cv::Mat in_middle = mask(middle) & ~body(middle);
+        EXPECT_LT(cv::countNonZero(in_middle), 0.05 * middle.area()) << part_faces;
+      }
+    }
+    return best;
+  };
+  const double parted = covered(true), whole = covered(false);
+  EXPECT_GE(parted, 0.55);
+  EXPECT_LT(whole, 0.1);
+}
+
 TEST(SkinTest, BadInputIsRefused) {
   SkinSegmenter segmenter(NoFaces());
   testing::ExpectError([&] { segmenter.Segment(cv::Mat()); }, "8-bit BGR");

@@ -103,6 +103,61 @@ cv::Mat Working(const cv::Mat& bgr, int width, int* scale) {
   return work;
 }
 
+// Of the skin within the faces' heads (`heads`: 255 within them; all images at the working
+// resolution, `bounds` holding the heads), what lies in front of a face:
+// 255 where the skin is parted from the skin at a face's centre (the middle half of its box,
+// `centres`) by the frame's edges, in pieces of at least `least` pixels. A hand over a face
+// shows its outline against it; the face's own edges (eyes, mouth, hair line) part smaller
+// pieces of it, a cheek or the brow, which stay the face's.
+cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& heads, cv::Rect bounds,
+                       const std::vector<cv::Rect>& centres, double least) {
+  cv::Mat in_front = cv::Mat::zeros(work.size(), CV_8UC1);
+  if (bounds.area() == 0 || centres.empty()) return in_front;
+  cv::Mat grey, edges;
+  cv::cvtColor(work(bounds), grey, cv::COLOR_BGR2GRAY);
+  // Low thresholds: an outline of skin against skin has little contrast.
+  cv::Canny(grey, edges, 30.0, 60.0);
+  cv::dilate(edges, edges, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
+  cv::Mat pieces = skin(bounds) & heads(bounds) & ~edges;
+  // Gaps in an outline leave narrow bridges between the hand and the face: an opening a
+  // twelfth of a face wide breaks them.
+  int widest = 0;
+  for (const cv::Rect& c : centres) widest = std::max(widest, 2 * c.width);
+  const int k = std::max(3, widest / 12) | 1;
+  cv::morphologyEx(pieces, pieces, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(pieces, labels, stats, centroids, 4, CV_32S);
+  if (count <= 1) return in_front;
+  // Each face is the piece with most pixels in its centre.
+  std::vector<uint8_t> face(count, 0);
+  for (const cv::Rect& centre : centres) {
+    const cv::Rect at = (centre - bounds.tl()) & cv::Rect(0, 0, bounds.width, bounds.height);
+    std::vector<int> pixels(count, 0);
+    for (int y = at.y; y < at.y + at.height; ++y) {
+      const int* label = labels.ptr<int>(y);
+      for (int x = at.x; x < at.x + at.width; ++x) ++pixels[label[x]];
+    }
+    const auto most = std::max_element(pixels.begin() + 1, pixels.end());
+    if (*most > 0) face[most - pixels.begin()] = 1;
+  }
+  cv::Mat kept = cv::Mat::zeros(labels.size(), CV_8UC1), face_pieces = cv::Mat::zeros(labels.size(), CV_8UC1);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* label = labels.ptr<int>(y);
+    uint8_t* keep = kept.ptr<uint8_t>(y);
+    uint8_t* of_face = face_pieces.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      if (label[x] == 0) continue;
+      const bool small = stats.at<int>(label[x], cv::CC_STAT_AREA) < least;
+      (face[label[x]] != 0 || small ? of_face : keep)[x] = 255;
+    }
+  }
+  // The kept pieces grown back over what the edges and the opening took from them, short
+  // of the face's own pieces.
+  cv::dilate(kept, kept, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k + 2, k + 2)));
+  in_front(bounds) = kept & skin(bounds) & heads(bounds) & ~face_pieces;
+  return in_front;
+}
+
 }  // namespace
 
 cv::Mat SkinSegmentation::Mask(const std::vector<int>& which, cv::Rect box) const {
@@ -235,9 +290,10 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     }
   }
   out.faces = faces_;
-  // Each face's head (an ellipse about its box) and neck (a rectangle below), grown by
-  // `grow` faces' widths, drawn into `mask` (working pixels); returns their bounds.
-  auto draw_faces = [&](double grow, cv::Mat* mask) {
+  // Each face's head (an ellipse about its box) and, with `necks`, neck (a rectangle
+  // below), grown by `grow` faces' widths, drawn into `mask` (working pixels); returns their
+  // bounds.
+  auto draw_faces = [&](double grow, bool necks, cv::Mat* mask) {
     cv::Rect bounds;
     for (const cv::Rect& frame_face : faces_) {
       const cv::Rect f = working_box(frame_face);
@@ -246,30 +302,56 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
       const cv::Size head(f.width * 7 / 10 + g, f.height * 9 / 10 + g);
       const cv::Rect neck(f.x + f.width / 5 - g, centre.y, f.width * 3 / 5 + 2 * g, f.height * 3 / 2 + g);
       cv::ellipse(*mask, centre, head, 0, 0, 360, cv::Scalar(255), cv::FILLED);
+      bounds |= cv::Rect(centre - cv::Point(head.width, head.height), centre + cv::Point(head.width, head.height));
+      if (!necks) continue;
       cv::rectangle(*mask, neck, cv::Scalar(255), cv::FILLED);
-      bounds |= cv::Rect(centre - cv::Point(head.width, head.height), centre + cv::Point(head.width, head.height)) | neck;
+      bounds |= neck;
     }
     return bounds & whole;
   };
+  // Skin a face's outline parts from it (a hand in front of it), working pixels: pieces of
+  // at least kInFrontShare of the face's box (a hand near a face is about as large as it).
+  cv::Mat in_front;
   if (!faces_.empty()) {
     cv::Mat face_mask = cv::Mat::zeros(work.size(), CV_8UC1);
-    draw_faces(0.0, &face_mask);
+    draw_faces(0.0, true, &face_mask);
+    if (options_.part_faces) {
+      // Only within the heads: a chin's edge parts every neck from its face.
+      cv::Mat heads = cv::Mat::zeros(work.size(), CV_8UC1);
+      const cv::Rect bounds = draw_faces(0.0, false, &heads);
+      std::vector<cv::Rect> centres;
+      int smallest = work.cols * work.rows;
+      for (const cv::Rect& face : faces_) {
+        const cv::Rect f = working_box(face);
+        centres.emplace_back(f.x + f.width / 4, f.y + f.height / 4, f.width / 2, f.height / 2);
+        smallest = std::min(smallest, f.area());
+      }
+      in_front = InFrontOfFaces(work, out.skin, heads, bounds, centres, kInFrontShare * smallest);
+      face_mask &= ~in_front;
+    }
     out.face_pixels = cv::countNonZero(out.skin & face_mask) * scale * scale;
     out.skin.setTo(0, face_mask);
   }
 
   const std::vector<RegionStats> stats = LabelRegions(out.skin, &out.labels);
   // What the set-aside shapes leave of a head or neck (the edge of a wider neck, a cheek):
-  // regions lying almost wholly within a fifth of a face's width of them.
+  // regions lying almost wholly within a fifth of a face's width of them, unless they hold
+  // skin in front of a face.
   std::vector<int> near_face;  // by label: its pixels in the zone (empty without faces)
+  std::vector<uint8_t> before_face;  // by label: it holds skin in front of a face
   if (!faces_.empty()) {
     near_face.assign(stats.size(), 0);
+    before_face.assign(stats.size(), 0);
     cv::Mat zone = cv::Mat::zeros(work.size(), CV_8UC1);
-    const cv::Rect bounds = draw_faces(0.2, &zone);
+    const cv::Rect bounds = draw_faces(0.2, true, &zone);
     for (int y = bounds.y; y < bounds.y + bounds.height; ++y) {
       const uint8_t* in_zone = zone.ptr<uint8_t>(y);
+      const uint8_t* front = in_front.empty() ? nullptr : in_front.ptr<uint8_t>(y);
       const int* label = out.labels.ptr<int>(y);
-      for (int x = bounds.x; x < bounds.x + bounds.width; ++x) near_face[label[x]] += in_zone[x] != 0;
+      for (int x = bounds.x; x < bounds.x + bounds.width; ++x) {
+        near_face[label[x]] += in_zone[x] != 0;
+        if (front != nullptr && front[x] != 0) before_face[label[x]] = 1;
+      }
     }
   }
   const int min_area = std::max(1, static_cast<int>(options_.min_area * work.total()));
@@ -277,7 +359,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   for (size_t label = 1; label < stats.size(); ++label) {
     const RegionStats& found = stats[label];
     if (found.area < min_area) continue;
-    if (!near_face.empty() && near_face[label] >= 0.8 * found.area) {
+    if (!near_face.empty() && before_face[label] == 0 && near_face[label] >= 0.8 * found.area) {
       out.face_pixels += found.area * scale * scale;
       continue;
     }

@@ -46,6 +46,11 @@ struct SkinOptions {
   // set aside from the skin.
   std::string face_cascade = kDefaultFaceCascade;
   int face_interval = 30;
+  // A hand held in front of a face: of the skin within a face's head, the pieces that the
+  // frame's edges (Canny on grey) part from the skin at the face's centre, if not much
+  // smaller than a hand, are something in front of the face and stay skin; the rest, and
+  // the neck, are the face's.
+  bool part_faces = true;
   bool Check(std::string* why) const;
 };
 
@@ -102,6 +107,7 @@ class SkinSegmenter {
   std::vector<cv::Mat> face_looks_;  // by face: its grey pixels where last seen, kFollowSide wide
   static constexpr int kFollowSide = 24;
   static constexpr double kFollowScore = 0.5;  // normalised correlation a followed face must reach
+  static constexpr double kInFrontShare = 0.15;  // least piece in front of a face, of its box
   struct FaceDetector;
   std::shared_ptr<FaceDetector> detector_;
 };
