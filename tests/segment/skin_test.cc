@@ -205,6 +205,37 @@ TEST(SkinTest, AFaceFoundIsFollowedBetweenLooks) {
   EXPECT_EQ(gone.faces[0], at);
 }
 
+// A face the cascade misses at a look, because a hand covers its eyes, is kept while its
+// look still matches where it was; one that is gone is dropped at the look.
+TEST(SkinTest, AFaceCoveredAtALookIsKeptWhileItStillMatches) {
+  SkinOptions options;
+  options.face_interval = 2;
+  SkinSegmenter segmenter(options);
+  const cv::Mat wall = MakeBackground(BackgroundKind::kClutter, cv::Size(640, 480), 3);
+  cv::Mat face = wall.clone();
+  DrawFace(SkinToneByName("olive").bgr, cv::Point(300, 220), 180, &face);
+  const SkinSegmentation first = segmenter.Segment(face);
+  ASSERT_TRUE(first.faces_looked);
+  ASSERT_EQ(first.faces.size(), 1u);
+  const cv::Rect at = first.faces[0];
+  EXPECT_FALSE(segmenter.Segment(face).faces_looked);
+  cv::Mat covered = face.clone();
+  const cv::Vec3f hand = SkinToneByName("brown").bgr;
+  cv::rectangle(covered, cv::Rect(at.x - 40, at.y + at.height / 5, at.width + 80, at.height * 2 / 5),
+                cv::Scalar(hand[0], hand[1], hand[2]), cv::FILLED);
+  SkinSegmenter fresh(options);
+  EXPECT_TRUE(fresh.Segment(covered).faces.empty()) << "the cascade alone misses the covered face";
+  const SkinSegmentation look = segmenter.Segment(covered);
+  EXPECT_TRUE(look.faces_looked);
+  ASSERT_EQ(look.faces.size(), 1u);
+  EXPECT_LE(std::abs(look.faces[0].x - at.x) + std::abs(look.faces[0].y - at.y), 4);
+  EXPECT_GT(look.face_pixels, 0);
+  segmenter.Segment(wall);
+  const SkinSegmentation gone = segmenter.Segment(wall);
+  EXPECT_TRUE(gone.faces_looked);
+  EXPECT_TRUE(gone.faces.empty());
+}
+
 // A hand held in front of a face, its forearm coming in from the frame's edge (the demo's
 // opening frames): the head's skin that the hand's outline parts from the face stays skin, in
 // one region with the fingers and the arm; the face's own skin is set aside all the same.

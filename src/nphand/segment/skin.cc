@@ -229,7 +229,40 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     cv::cvtColor(work(r), grey, cv::COLOR_BGR2GRAY);
     return grey;
   };
+  // Follows face i: its grey look where it was last seen (kFollowSide pixels wide) matched
+  // around there, a face's side each way; where it matches it is the face's new place and
+  // look (a turned or nearer face changes its look a little each frame). False where it does
+  // not match (covered, or gone).
+  auto follow = [&](size_t i) {
+    cv::Rect& face = faces_[i];
+    const cv::Rect at = working_box(face);
+    const cv::Rect roi = cv::Rect(at.x - at.width, at.y - at.height, at.width * 3, at.height * 3) & whole;
+    const double shrink = static_cast<double>(kFollowSide) / at.width;
+    cv::Mat small;
+    cv::resize(grey_of(roi), small, cv::Size(), shrink, shrink, cv::INTER_AREA);
+    const cv::Mat& looks = face_looks_[i];
+    if (small.cols < looks.cols || small.rows < looks.rows) return false;
+    cv::Mat score;
+    cv::matchTemplate(small, looks, score, cv::TM_CCOEFF_NORMED);
+    double best = 0.0;
+    cv::Point where;
+    cv::minMaxLoc(score, nullptr, &best, nullptr, &where);
+    if (best < kFollowScore) return false;
+    face.x = (roi.x + static_cast<int>(std::lround(where.x / shrink))) * scale;
+    face.y = (roi.y + static_cast<int>(std::lround(where.y / shrink))) * scale;
+    small(cv::Rect(where, looks.size())).copyTo(face_looks_[i]);
+    return true;
+  };
   if (detector_ != nullptr && look) {
+    // The faces followed so far that still match where they were: the cascade misses a face
+    // a hand covers in part, and such a face is kept.
+    std::vector<cv::Rect> followed;
+    std::vector<cv::Mat> followed_looks;
+    for (size_t i = 0; i < faces_.size(); ++i) {
+      if (!follow(i)) continue;
+      followed.push_back(faces_[i]);
+      followed_looks.push_back(face_looks_[i]);
+    }
     // A face is skin: the cascade looks only around skin regions that could hold one (their
     // box grown by a quarter of a side each way, for the hair and a face cut by a hand).
     out.faces_looked = true;
@@ -265,29 +298,15 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
       cv::resize(grey_of(at), looks, cv::Size(kFollowSide, kFollowSide * at.height / std::max(1, at.width)), 0.0, 0.0, cv::INTER_AREA);
       face_looks_.push_back(looks);
     }
-  } else {
-    // Each face is followed: its grey look where it was last seen (kFollowSide pixels wide)
-    // matched around there, a face's side each way; where it matches it is the face's new
-    // place and look (a turned or nearer face changes its look a little each frame).
-    for (size_t i = 0; i < faces_.size(); ++i) {
-      cv::Rect& face = faces_[i];
-      const cv::Rect at = working_box(face);
-      const cv::Rect roi = cv::Rect(at.x - at.width, at.y - at.height, at.width * 3, at.height * 3) & whole;
-      const double shrink = static_cast<double>(kFollowSide) / at.width;
-      cv::Mat small;
-      cv::resize(grey_of(roi), small, cv::Size(), shrink, shrink, cv::INTER_AREA);
-      const cv::Mat& looks = face_looks_[i];
-      if (small.cols < looks.cols || small.rows < looks.rows) continue;
-      cv::Mat score;
-      cv::matchTemplate(small, looks, score, cv::TM_CCOEFF_NORMED);
-      double best = 0.0;
-      cv::Point where;
-      cv::minMaxLoc(score, nullptr, &best, nullptr, &where);
-      if (best < kFollowScore) continue;  // not seen (covered, or gone): it stays until the next look
-      face.x = (roi.x + static_cast<int>(std::lround(where.x / shrink))) * scale;
-      face.y = (roi.y + static_cast<int>(std::lround(where.y / shrink))) * scale;
-      small(cv::Rect(where, looks.size())).copyTo(face_looks_[i]);
+    for (size_t i = 0; i < followed.size(); ++i) {
+      const cv::Rect& face = followed[i];
+      if (std::any_of(faces_.begin(), faces_.end(), [&](const cv::Rect& g) { return (g & face).area() > 0; })) continue;
+      faces_.push_back(face);
+      face_looks_.push_back(followed_looks[i]);
     }
+  } else {
+    // Each face is followed; one not seen stays where it was until the next look.
+    for (size_t i = 0; i < faces_.size(); ++i) follow(i);
   }
   out.faces = faces_;
   // Each face's head (an ellipse about its box) and, with `necks`, neck (a rectangle
