@@ -355,7 +355,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   const std::vector<RegionStats> stats = LabelRegions(out.skin, &out.labels);
   // What the set-aside shapes leave of a head or neck (the edge of a wider neck, a cheek):
   // regions lying almost wholly within a fifth of a face's width of them, unless they hold
-  // skin in front of a face.
+  // skin in front of a face or lie beside such a region.
   std::vector<int> near_face;  // by label: its pixels in the zone (empty without faces)
   std::vector<uint8_t> before_face;  // by label: it holds skin in front of a face
   if (!faces_.empty()) {
@@ -374,11 +374,25 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     }
   }
   const int min_area = std::max(1, static_cast<int>(options_.min_area * work.total()));
+  // Nor are pieces beside skin in front of a face (fingers an object or an outline split
+  // from the hand over the face): within the reach of such a region's box, grown by 0.3 of
+  // its longer side as the estimator gathers a hand's pieces.
+  std::vector<cv::Rect> reaches;
+  for (size_t label = 1; label < before_face.size(); ++label) {
+    if (before_face[label] == 0 || stats[label].area < min_area) continue;
+    const cv::Rect& b = stats[label].box;
+    const int grow = static_cast<int>(0.3 * std::max(b.width, b.height));
+    reaches.emplace_back(b.x - grow, b.y - grow, b.width + 2 * grow, b.height + 2 * grow);
+  }
+  auto beside_front = [&](const cv::Rect& box) {
+    return std::any_of(reaches.begin(), reaches.end(), [&](const cv::Rect& r) { return (r & box).area() > 0; });
+  };
   const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
   for (size_t label = 1; label < stats.size(); ++label) {
     const RegionStats& found = stats[label];
     if (found.area < min_area) continue;
-    if (!near_face.empty() && before_face[label] == 0 && near_face[label] >= 0.8 * found.area) {
+    if (!near_face.empty() && before_face[label] == 0 && near_face[label] >= 0.8 * found.area &&
+        !beside_front(found.box)) {
       out.face_pixels += found.area * scale * scale;
       continue;
     }
