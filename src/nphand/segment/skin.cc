@@ -104,11 +104,11 @@ cv::Mat Working(const cv::Mat& bgr, int width, int* scale) {
 }
 
 // Of the skin within the faces' heads (`heads`: 255 within them; all images at the working
-// resolution, `bounds` holding the heads), what lies in front of a face:
-// 255 where the skin is parted from the skin at a face's centre (the middle half of its box,
-// `centres`) by the frame's edges, in pieces of at least `least` pixels. A hand over a face
-// shows its outline against it; the face's own edges (eyes, mouth, hair line) part smaller
-// pieces of it, a cheek or the brow, which stay the face's.
+// resolution, `bounds` holding the heads), what lies in front of a face: 255 where the skin
+// is parted from the skin at a face's centre (the middle half of its box, `centres`) by the
+// frame's edges, in pieces of at least `least` pixels. A hand over a face shows its outline
+// against it; the face's own edges (eyes, mouth, hair line) part smaller pieces of it, a
+// cheek or the brow, which stay the face's.
 cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& heads, cv::Rect bounds,
                        const std::vector<cv::Rect>& centres, double least) {
   cv::Mat in_front = cv::Mat::zeros(work.size(), CV_8UC1);
