@@ -390,14 +390,7 @@ TEST_F(EstimatorTest, NoEstimateSitsOnTheFaceOrNeck) {
   int detected = 0, on_hand = 0;
   for (uint64_t seed : {11u, 12u}) {
     Estimator estimator(*db_, *index_, RightHand(), options);
-    SequenceOptions sequence;
-    sequence.frames = 120;
-    sequence.grasp = 1;
-    sequence.object_scale = 0.8;
-    sequence.background = BackgroundKind::kClutter;
-    sequence.face = true;
-    sequence.seed = seed;
-    Sequence frames(RightHand(), sequence);
+    Sequence frames(RightHand(), testing::DemoSequence(seed));
     for (int i = 0; i < frames.size(); i += 2) {
       const SequenceFrame frame = frames.Render(i);
       const FrameResult r = estimator.Process(frame.rgb, frame.time_s);

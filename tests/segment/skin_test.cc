@@ -240,14 +240,7 @@ TEST(SkinTest, AFaceCoveredAtALookIsKeptWhileItStillMatches) {
 // opening frames): the head's skin that the hand's outline parts from the face stays skin, in
 // one region with the fingers and the arm; the face's own skin is set aside all the same.
 TEST(SkinTest, AHandInFrontOfAFaceKeepsWhatItsOutlinePartsFromTheFace) {
-  SequenceOptions options;
-  options.frames = 120;
-  options.grasp = 1;
-  options.object_scale = 0.8;
-  options.background = BackgroundKind::kClutter;
-  options.face = true;
-  options.seed = 11;
-  Sequence sequence(testing::RightHand(), options);
+  Sequence sequence(testing::RightHand(), testing::DemoSequence(11));
   const SequenceFrame frame = sequence.Render(2);
   const cv::Mat body = (frame.labels == static_cast<int>(PixelLabel::kHand)) |
                        (frame.labels == static_cast<int>(PixelLabel::kForearm));

@@ -15,6 +15,18 @@ const HandModel& RightHand() {
   return model;
 }
 
+SequenceOptions DemoSequence(uint64_t seed) {
+  SequenceOptions options;
+  options.frames = 120;
+  options.grasp = 1;
+  options.object_scale = 0.8;
+  options.forearm = ForearmKind::kBare;
+  options.background = BackgroundKind::kClutter;
+  options.face = true;
+  options.seed = seed;
+  return options;
+}
+
 const HandModel& LeftHand() {
   static const HandModel model = HandModel::Load(Handedness::kLeft);
   return model;

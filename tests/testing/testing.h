@@ -6,12 +6,17 @@
 #include <string>
 
 #include "nphand/model/hand_model.h"
+#include "nphand/sequence/sequence.h"
 
 namespace nphand::testing {
 
 // The hand models, loaded once per test binary from the set-up cache.
 const HandModel& RightHand();
 const HandModel& LeftHand();
+
+// The demo's sequence (scripts/demo.sh) with `seed`: a hand with a bare forearm closing
+// onto a cylinder 0.8 times the database's, 120 frames before clutter and a face.
+SequenceOptions DemoSequence(uint64_t seed);
 
 // A fresh empty folder for the running test, under the system's temporary folder.
 std::filesystem::path ScratchDir();

@@ -11,6 +11,7 @@
 #include "nphand/features/crop.h"
 #include "nphand/features/descriptor.h"
 #include "nphand/scene/viewpoint.h"
+#include "nphand/segment/regions.h"
 #include "nphand/util/check.h"
 #include "nphand/util/parallel.h"
 
@@ -27,8 +28,7 @@ double Ms(Clock::time_point from, Clock::time_point to) {
 // meet the region's box grown by 30 % of its longer side): their pixels within `*box`, which
 // gets the pixels' bounds.
 cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, cv::Rect* box) {
-  const int grow = static_cast<int>(0.3 * std::max(seed.box.width, seed.box.height));
-  const cv::Rect reach(seed.box.x - grow, seed.box.y - grow, seed.box.width + 2 * grow, seed.box.height + 2 * grow);
+  const cv::Rect reach = HandReach(seed.box);
   std::vector<int> labels = {seed.label};
   cv::Rect bounds = seed.box;
   for (const SkinRegion& r : s.regions) {

@@ -224,23 +224,24 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
         }
         run.push_back(r.keypoints_hand);
         ++score.detected;
-        for (size_t lag = 0; lag <= std::min<size_t>(kMaxLag, t); ++lag) {
-          lag_error[lag] += RootRelativeError(r.keypoints_hand, frames[t - lag].keypoints);
-          ++lag_count[lag];
-        }
         score.both_turns += r.both_turns;
-        double joint = 0.0, keypoint = 0.0, px = 0.0, camera = 0.0;
+        double joint = 0.0, px = 0.0, camera = 0.0;
         for (int d = 0; d < kNumDofs; ++d) joint += std::abs(r.pose.angles[d] - truth.pose.angles[d]);
         for (int k = 0; k < kNumKeypoints; ++k) {
-          keypoint += (r.keypoints_hand[k] - truth.keypoints[k]).norm();
           px += (r.keypoints_2d[k] - truth.keypoints_2d[k]).norm();
           camera += (r.keypoints_camera[k] - (truth.wrist_in_camera + truth.keypoints[k])).norm();
+        }
+        // The keypoints' error, and the same against the truth of each frame before (the lag's).
+        const double keypoint = RootRelativeError(r.keypoints_hand, truth.keypoints);
+        for (size_t lag = 0; lag <= std::min<size_t>(kMaxLag, t); ++lag) {
+          lag_error[lag] += lag == 0 ? keypoint : RootRelativeError(r.keypoints_hand, frames[t - lag].keypoints);
+          ++lag_count[lag];
         }
         score.joint_deg += joint / kNumDofs * 180.0 / std::numbers::pi;
         const double wrist = RotationAngleDeg(r.pose.camera_from_hand, truth.pose.camera_from_hand);
         score.wrist_deg += wrist;
         score.turned += wrist >= kTurnedDeg;
-        score.keypoint_mm += 1000.0 * keypoint / kNumKeypoints;
+        score.keypoint_mm += 1000.0 * keypoint;
         score.keypoint_px += px / kNumKeypoints;
         score.camera_mm += 1000.0 * camera / kNumKeypoints;
       }

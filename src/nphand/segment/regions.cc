@@ -73,4 +73,9 @@ std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels) {
   return stats;
 }
 
+cv::Rect HandReach(const cv::Rect& box) {
+  const int grow = static_cast<int>(0.3 * std::max(box.width, box.height));
+  return cv::Rect(box.x - grow, box.y - grow, box.width + 2 * grow, box.height + 2 * grow);
+}
+
 }  // namespace nphand

@@ -34,4 +34,8 @@ struct RegionStats {
 // is left empty). Throws nphand::Error for another type of mask.
 std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels);
 
+// How far from a region's box its hand's other pieces may lie (fingers an object or an
+// outline split off): the box grown by 0.3 of its longer side each way.
+cv::Rect HandReach(const cv::Rect& box);
+
 }  // namespace nphand

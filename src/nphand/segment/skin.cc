@@ -126,6 +126,8 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   const int k = std::max(3, widest / 12) | 1;
   cv::morphologyEx(pieces, pieces, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
   cv::Mat labels, stats, centroids;
+  // 4-connected, not LabelRegions' 8: pieces an outline parts that still touch at a corner
+  // stay apart.
   const int count = cv::connectedComponentsWithStats(pieces, labels, stats, centroids, 4, CV_32S);
   if (count <= 1) return in_front;
   // Each face is the piece with most pixels in its centre.
@@ -375,14 +377,11 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   }
   const int min_area = std::max(1, static_cast<int>(options_.min_area * work.total()));
   // Nor are pieces beside skin in front of a face (fingers an object or an outline split
-  // from the hand over the face): within the reach of such a region's box, grown by 0.3 of
-  // its longer side as the estimator gathers a hand's pieces.
+  // from the hand over the face): within the reach of such a region, as the estimator
+  // gathers a hand's pieces.
   std::vector<cv::Rect> reaches;
   for (size_t label = 1; label < before_face.size(); ++label) {
-    if (before_face[label] == 0 || stats[label].area < min_area) continue;
-    const cv::Rect& b = stats[label].box;
-    const int grow = static_cast<int>(0.3 * std::max(b.width, b.height));
-    reaches.emplace_back(b.x - grow, b.y - grow, b.width + 2 * grow, b.height + 2 * grow);
+    if (before_face[label] != 0 && stats[label].area >= min_area) reaches.push_back(HandReach(stats[label].box));
   }
   auto beside_front = [&](const cv::Rect& box) {
     return std::any_of(reaches.begin(), reaches.end(), [&](const cv::Rect& r) { return (r & box).area() > 0; });
