@@ -160,6 +160,25 @@ TEST(ForearmTest, AThumbHeldOutDoesNotHideTheArm) {
       << "the fingers stay";
 }
 
+// Two fingers held together before a palm look like an arm before a hand: narrow, then a
+// widening. Within the frame an arm must be 1.4 of its widths long; the fingers are 1.3 and
+// stay, an arm of 1.6 is cut.
+TEST(ForearmTest, ShortFingersWithinTheFrameAreNoArm) {
+  auto shape = [](int stretch) {
+    cv::Mat region = cv::Mat::zeros(300, 200, CV_8UC1);
+    cv::rectangle(region, cv::Rect(80, 240 - stretch, 40, stretch), cv::Scalar(255), cv::FILLED);  // fingers or arm
+    cv::rectangle(region, cv::Rect(50, 240, 100, 50), cv::Scalar(255), cv::FILLED);                 // palm
+    return region;
+  };
+  const cv::Mat fingers = shape(52);
+  const ForearmCut f = CutForearm(fingers, 0);
+  EXPECT_FALSE(f.cut);
+  EXPECT_EQ(cv::countNonZero(f.hand != fingers), 0);
+  const ForearmCut a = CutForearm(shape(64), 0);
+  ASSERT_TRUE(a.cut);
+  EXPECT_LT(a.arm_direction.y, -0.9) << "the arm is the top end";
+}
+
 TEST(ForearmTest, ARegionWithoutAnArmIsLeftWhole) {
   cv::Mat disc = cv::Mat::zeros(200, 200, CV_8UC1);
   cv::circle(disc, cv::Point(100, 100), 60, cv::Scalar(255), cv::FILLED);

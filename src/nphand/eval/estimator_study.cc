@@ -63,6 +63,13 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     name << "turns" << ambiguity;
     around_default(name.str(), [&](EstimatorOptions& e) { e.roll_ambiguity = ambiguity; });
   }
+  // How long an arm must be (in its widths) unless it enters from the frame's edge: shorter
+  // and it is taken for fingers.
+  for (double length : {1.2, 1.6, 2.0}) {
+    std::ostringstream name;
+    name << "arm-length" << length;
+    around_default(name.str(), [&](EstimatorOptions& e) { e.forearm.min_arm_length = length; });
+  }
   // Refinement beyond the database (refine/refiner.h): its default (the place and the
   // wrist, pulled towards the last frame's), the place alone, with the fingers too (in two
   // step sizes), other pulls, finer renders and more passes.
