@@ -118,7 +118,8 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   // Low thresholds: an outline of skin against skin has little contrast.
   cv::Canny(grey, edges, 30.0, 60.0);
   cv::dilate(edges, edges, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
-  cv::Mat pieces = skin(bounds) & heads(bounds) & ~edges;
+  const cv::Mat head_skin = skin(bounds) & heads(bounds);
+  cv::Mat pieces = head_skin & ~edges;
   // Gaps in an outline leave narrow bridges between the hand and the face: an opening a
   // twelfth of a face wide breaks them.
   int widest = 0;
@@ -156,7 +157,7 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   // The kept pieces grown back over what the edges and the opening took from them, short
   // of the face's own pieces.
   cv::dilate(kept, kept, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k + 2, k + 2)));
-  in_front(bounds) = kept & skin(bounds) & heads(bounds) & ~face_pieces;
+  in_front(bounds) = kept & head_skin & ~face_pieces;
   return in_front;
 }
 
