@@ -132,6 +132,27 @@ TEST(SkinTest, AFrameWithoutSkinHasNoRegionAndAFaceIsMarked) {
   EXPECT_GT(found.regions[0].area, 10000);
 }
 
+// A frame without colour (greyscale, an infrared camera's) says so; a colour frame does not.
+TEST(SkinTest, AGreyscaleFrameIsColourless) {
+  SequenceOptions options;
+  options.frames = 4;
+  options.width = 320;
+  options.height = 240;
+  options.seed = 5;
+  Sequence sequence(testing::RightHand(), options);
+  const cv::Mat colour = sequence.Render(1).rgb;
+  SkinSegmenter segmenter(NoFaces());
+  const SkinSegmentation in_colour = segmenter.Segment(colour);
+  EXPECT_FALSE(in_colour.colourless);
+  EXPECT_FALSE(in_colour.regions.empty());
+  cv::Mat grey, grey_bgr;
+  cv::cvtColor(colour, grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(grey, grey_bgr, cv::COLOR_GRAY2BGR);
+  const SkinSegmentation in_grey = segmenter.Segment(grey_bgr);
+  EXPECT_TRUE(in_grey.colourless);
+  EXPECT_TRUE(in_grey.regions.empty());
+}
+
 // The cascade runs every face_interval frames, and on the frame after a region that could
 // hold a face came into view; a region that moves or grows within its box is not new.
 TEST(SkinTest, TheFaceCascadeLooksWhenSomeoneComesIntoView) {

@@ -408,7 +408,9 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {
   result.ms.segment = Ms(start, Clock::now());
   if (candidates.empty()) {
     result.status = FrameStatus::kNoSkin;
-    result.reason = skin.face_pixels > 0 ? "only faces are skin-coloured" : "no skin-coloured region";
+    result.reason = skin.colourless         ? "the frame has no colour (greyscale): skin cannot be told by its colour"
+                    : skin.face_pixels > 0 ? "only faces are skin-coloured"
+                                           : "no skin-coloured region";
     carried_.clear();
     result.ms.total = Ms(start, Clock::now());
     return result;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <vector>
 
@@ -191,13 +192,16 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   cv::Mat ycrcb;
   cv::cvtColor(work, ycrcb, cv::COLOR_BGR2YCrCb);
   out.skin.create(work.size(), CV_8UC1);
+  int chroma = 0;  // the farthest any pixel's chroma lies from grey
   for (int y = 0; y < ycrcb.rows; ++y) {
     const cv::Vec3b* in = ycrcb.ptr<cv::Vec3b>(y);
     uint8_t* skin = out.skin.ptr<uint8_t>(y);
     for (int x = 0; x < ycrcb.cols; ++x) {
       skin[x] = in[x][0] >= options_.y_min ? lookup_.at<uint8_t>(in[x][1], in[x][2]) : 0;
+      chroma = std::max({chroma, std::abs(in[x][1] - 128), std::abs(in[x][2] - 128)});
     }
   }
+  out.colourless = chroma <= kColourlessChroma;
   // A size in frame pixels at the working resolution: odd, so that the kernel is centred.
   auto working = [&](int px) { return ((px + scale - 1) / scale) | 1; };
   if (options_.open_px > 1) {

@@ -62,6 +62,10 @@ struct SkinRegion {
   cv::Point2d centroid;
 };
 
+// How far (8-bit Cr and Cb levels) from grey a colourless frame's pixels may lie: a JPEG
+// of a grey image keeps its chroma within a level or two of 128.
+inline constexpr int kColourlessChroma = 3;
+
 struct SkinSegmentation {
   cv::Size frame;                   // the frame's size
   int scale = 1;                    // frame pixels per working pixel (a power of 2)
@@ -71,6 +75,9 @@ struct SkinSegmentation {
   std::vector<cv::Rect> faces;      // the faces in view (the last look's, followed since), frame pixels
   int face_pixels = 0;              // frame pixels of skin set aside as faces (heads, necks and what they leave of them)
   bool faces_looked = false;        // the face cascade ran on this frame
+  // The frame has no colour (greyscale, or an infrared camera's): every pixel's chroma lies
+  // within kColourlessChroma of grey, so skin colour cannot be told from anything else.
+  bool colourless = false;
   // The pixels of the regions labelled `which` within `box` (frame pixels), at the frame's
   // resolution: CV_8UC1 of the box's size, 255 = skin.
   cv::Mat Mask(const std::vector<int>& which, cv::Rect box) const;
