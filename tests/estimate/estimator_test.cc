@@ -339,11 +339,8 @@ TEST_F(EstimatorTest, FramesWithoutAHandSaySo) {
   r = estimator.Process(face, 0.0);
   EXPECT_EQ(r.status, FrameStatus::kNoSkin);
   EXPECT_EQ(r.reason, "only faces are skin-coloured");
-  cv::Mat grey, grey_bgr;
-  cv::cvtColor(face, grey, cv::COLOR_BGR2GRAY);
-  cv::cvtColor(grey, grey_bgr, cv::COLOR_GRAY2BGR);
   estimator.Reset();
-  r = estimator.Process(grey_bgr, 0.0);
+  r = estimator.Process(testing::Greyscale(face), 0.0);
   EXPECT_EQ(r.status, FrameStatus::kNoSkin);
   EXPECT_EQ(r.reason, "the frame has no colour (greyscale): skin cannot be told by its colour");
   EXPECT_EQ(estimator.ProcessMask(cv::Mat::zeros(10, 10, CV_8UC1), 0.0).status, FrameStatus::kNoSkin);

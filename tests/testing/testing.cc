@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "nphand/util/check.h"
 
@@ -13,6 +14,13 @@ namespace nphand::testing {
 const HandModel& RightHand() {
   static const HandModel model = HandModel::Load(Handedness::kRight);
   return model;
+}
+
+cv::Mat Greyscale(const cv::Mat& bgr) {
+  cv::Mat grey, out;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(grey, out, cv::COLOR_GRAY2BGR);
+  return out;
 }
 
 SequenceOptions DemoSequence(uint64_t seed) {

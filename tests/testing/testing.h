@@ -5,6 +5,8 @@
 #include <functional>
 #include <string>
 
+#include <opencv2/core.hpp>
+
 #include "nphand/model/hand_model.h"
 #include "nphand/sequence/sequence.h"
 
@@ -17,6 +19,9 @@ const HandModel& LeftHand();
 // The demo's sequence (scripts/demo.sh) with `seed`: a hand with a bare forearm closing
 // onto a cylinder 0.8 times the database's, 120 frames before clutter and a face.
 SequenceOptions DemoSequence(uint64_t seed);
+
+// `bgr` as a greyscale or infrared camera gives it: grey, in three equal channels.
+cv::Mat Greyscale(const cv::Mat& bgr);
 
 // A fresh empty folder for the running test, under the system's temporary folder.
 std::filesystem::path ScratchDir();

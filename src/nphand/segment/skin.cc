@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <vector>
 
@@ -192,16 +191,13 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   cv::Mat ycrcb;
   cv::cvtColor(work, ycrcb, cv::COLOR_BGR2YCrCb);
   out.skin.create(work.size(), CV_8UC1);
-  int chroma = 0;  // the farthest any pixel's chroma lies from grey
   for (int y = 0; y < ycrcb.rows; ++y) {
     const cv::Vec3b* in = ycrcb.ptr<cv::Vec3b>(y);
     uint8_t* skin = out.skin.ptr<uint8_t>(y);
     for (int x = 0; x < ycrcb.cols; ++x) {
       skin[x] = in[x][0] >= options_.y_min ? lookup_.at<uint8_t>(in[x][1], in[x][2]) : 0;
-      chroma = std::max({chroma, std::abs(in[x][1] - 128), std::abs(in[x][2] - 128)});
     }
   }
-  out.colourless = chroma <= kColourlessChroma;
   // A size in frame pixels at the working resolution: odd, so that the kernel is centred.
   auto working = [&](int px) { return ((px + scale - 1) / scale) | 1; };
   if (options_.open_px > 1) {
@@ -422,6 +418,17 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   face_sized_ = std::move(face_sized);
   std::sort(out.regions.begin(), out.regions.end(),
             [](const SkinRegion& a, const SkinRegion& b) { return a.area != b.area ? a.area > b.area : a.label < b.label; });
+  // Only a frame without a region asks why: has it colour at all?
+  if (out.regions.empty()) {
+    out.colourless = true;
+    for (int channel : {1, 2}) {
+      cv::Mat chroma;
+      cv::extractChannel(ycrcb, chroma, channel);
+      double low = 0.0, high = 0.0;
+      cv::minMaxLoc(chroma, &low, &high);
+      out.colourless = out.colourless && low >= 128 - kColourlessChroma && high <= 128 + kColourlessChroma;
+    }
+  }
   return out;
 }
 

@@ -75,8 +75,9 @@ struct SkinSegmentation {
   std::vector<cv::Rect> faces;      // the faces in view (the last look's, followed since), frame pixels
   int face_pixels = 0;              // frame pixels of skin set aside as faces (heads, necks and what they leave of them)
   bool faces_looked = false;        // the face cascade ran on this frame
-  // The frame has no colour (greyscale, or an infrared camera's): every pixel's chroma lies
-  // within kColourlessChroma of grey, so skin colour cannot be told from anything else.
+  // A frame without regions that has no colour (greyscale, or an infrared camera's): every
+  // pixel's chroma lies within kColourlessChroma of grey, so skin colour cannot be told from
+  // anything else. Looked at only when no region was found (false otherwise).
   bool colourless = false;
   // The pixels of the regions labelled `which` within `box` (frame pixels), at the frame's
   // resolution: CV_8UC1 of the box's size, 255 = skin.
