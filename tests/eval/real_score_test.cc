@@ -111,6 +111,43 @@ TEST(RealScoreTest, PaMpjpeAndFingerStatesCompareTheShapeOnly) {
   EXPECT_FALSE(score.hands[0].handedness_ok.has_value()) << "no side predicted";
 }
 
+// A right palm towards the camera, fingers up: the thumb's side (index MCP) on the right.
+TEST(RealScoreTest, WhichSideFacesTheCameraFollowsTheTurnAndTheHandsSide) {
+  const Eigen::Vector2d wrist(100, 200), index(120, 160), little(80, 160);
+  EXPECT_EQ(FacingOf(wrist, index, little, "right"), Facing::kPalm);
+  EXPECT_EQ(FacingOf(wrist, index, little, "left"), Facing::kBack);
+  EXPECT_EQ(FacingOf(wrist, little, index, "right"), Facing::kBack) << "the mirror image";
+  const Eigen::Rotation2Dd turn(2.5);
+  EXPECT_EQ(FacingOf(turn * wrist, turn * index, turn * little, "right"), Facing::kPalm) << "any roll";
+  EXPECT_EQ(FacingOf(wrist, index, Eigen::Vector2d(118, 160), "right"), Facing::kUnknown) << "edge-on";
+  EXPECT_EQ(FacingOf(wrist, std::nullopt, little, "right"), Facing::kUnknown) << "an MCP unlabelled";
+  EXPECT_EQ(FacingOf(wrist, index, little, ""), Facing::kUnknown) << "no side";
+
+  const auto dir = testing::ScratchDir();
+  nlohmann::json palm = Keypoints(0, 0);
+  palm[0] = {wrist.x(), wrist.y()};
+  palm[5] = {index.x(), index.y()};
+  palm[17] = {little.x(), little.y()};
+  nlohmann::json back = palm;
+  back[5] = palm[17];
+  back[17] = palm[5];
+  Write(dir / "labels.jsonl", {{{"file", "images/freihand_1.jpg"}, {"hand", "right"}, {"keypoints_2d_px", palm}},
+                               {{"file", "images/freihand_2.jpg"}, {"hand", "right"}, {"keypoints_2d_px", palm}},
+                               {{"file", "images/freihand_3.jpg"}, {"hand", "right"}, {"keypoints_2d_px", palm}}});
+  Write(dir / "predictions.jsonl", {{{"file", "images/freihand_1.jpg"}, {"hands", {{{"keypoints_2d_px", palm}}}}},
+                                    {{"file", "images/freihand_2.jpg"}, {"hands", {{{"keypoints_2d_px", back}}}}},
+                                    {{"file", "images/freihand_3.jpg"}, {"hands", {{{"keypoints_2d_px", back}, {"hand", "left"}}}}}});
+  const std::vector<RealLabel> labels = ReadRealLabels(dir / "labels.jsonl");
+  const RealScore score = ScoreReal(labels, ReadRealPredictions(dir / "predictions.jsonl", labels));
+  EXPECT_TRUE(*score.hands[0].facing_ok);
+  EXPECT_FALSE(*score.hands[1].facing_ok);
+  EXPECT_TRUE(*score.hands[2].facing_ok) << "a left hand's mirror image shows the palm as the right one does";
+  EXPECT_EQ(score.gt_all.facing_n, 3);
+  EXPECT_EQ(score.gt_all.facing_correct, 2);
+  EXPECT_EQ(ToJson(score)["overall"]["gt_all"]["palm_back_correct"], 2);
+  EXPECT_NE(FormatTable(score).find("2/3"), std::string::npos);
+}
+
 TEST(RealScoreTest, MalformedLabelsAndPredictionsAreRefusedByLine) {
   const auto dir = testing::ScratchDir();
   const nlohmann::json good = {{"file", "images/freihand_1.jpg"}, {"hand", "right"}, {"keypoints_2d_px", Keypoints(0, 0)}};
@@ -199,6 +236,12 @@ TEST(RealScoreTest, FiguresAreTheReferenceScorersOnTheSamePredictions) {
   const auto dir = testing::ScratchDir();
   const std::vector<RealLabel> labels = ReadRealLabels(dev / "labels.jsonl");
   EXPECT_EQ(labels.size(), 390u);
+  // The fingerspelling video shows a right palm throughout: the facing's sense on a real hand.
+  for (const RealLabel& label : labels) {
+    if (label.source != "asl_video") continue;
+    EXPECT_EQ(FacingOf(label.keypoints_2d[0], label.keypoints_2d[5], label.keypoints_2d[17], label.hand), Facing::kPalm)
+        << "frame " << *label.frame;
+  }
   const std::vector<RealPrediction> predictions = SpoiledPredictions(labels);
   {
     std::ofstream out(dir / "predictions.jsonl");

@@ -21,6 +21,7 @@ constexpr std::array<const char*, 5> kGroundTruthSources = {"freihand", "onehand
 constexpr std::array<const char*, 3> kMediaPipeSources = {"tfjs_hands", "mediapipe_thumbs_up", "asl_video"};
 constexpr double kGrow = 0.25;
 constexpr double kExtendedRatio = 0.75;
+constexpr int kWrist = 0, kIndexMcp = 5, kLittleMcp = 17;
 constexpr std::array<std::array<int, 4>, 4> kFingers = {{{5, 6, 7, 8}, {9, 10, 11, 12}, {13, 14, 15, 16}, {17, 18, 19, 20}}};
 
 std::string Stem(const std::string& file) { return std::filesystem::path(file).stem().string(); }
@@ -186,6 +187,10 @@ RealAggregate Aggregate(const std::vector<const RealHandScore*>& rows, int extra
       a.finger_agree += *r->finger_agree;
       a.finger_total += 4;
     }
+    if (r->found && r->facing_ok.has_value()) {
+      ++a.facing_n;
+      a.facing_correct += *r->facing_ok;
+    }
   }
   a.pck_01_found = MeanOf(pck_01);
   a.pck_02_found = MeanOf(pck_02);
@@ -228,10 +233,24 @@ nlohmann::json ToJson(const RealAggregate& a) {
           {"pa_mpjpe_hands_with_3d_label", a.hands_with_3d_label},
           {"pa_mpjpe_mm", Optional(a.pa_mpjpe_mm)},
           {"finger_agree", a.finger_agree},
-          {"finger_total", a.finger_total}};
+          {"finger_total", a.finger_total},
+          {"palm_back_n", a.facing_n},
+          {"palm_back_correct", a.facing_correct}};
 }
 
 }  // namespace
+
+Facing FacingOf(const std::optional<Eigen::Vector2d>& wrist, const std::optional<Eigen::Vector2d>& index_mcp,
+                const std::optional<Eigen::Vector2d>& little_mcp, const std::string& hand) {
+  if (!wrist || !index_mcp || !little_mcp || (hand != "left" && hand != "right")) return Facing::kUnknown;
+  const Eigen::Vector2d a = *index_mcp - *wrist, b = *little_mcp - *wrist;
+  const double lengths = a.norm() * b.norm();
+  if (lengths <= 0.0) return Facing::kUnknown;
+  // Image y points down: a turn that looks counter-clockwise has a negative cross product.
+  const double sine = (a.x() * b.y() - a.y() * b.x()) / lengths;
+  if (std::abs(sine) < kEdgeOnSine) return Facing::kUnknown;
+  return (sine < 0.0) == (hand == "right") ? Facing::kPalm : Facing::kBack;
+}
 
 std::string RealSourceOf(const std::string& file) {
   const std::string base = std::filesystem::path(file).filename().string();
@@ -405,6 +424,11 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
           r.pck_01 = static_cast<double>(std::count_if(e.begin(), e.end(), [](double v) { return v < 0.1; })) / e.size();
           r.pck_02 = static_cast<double>(std::count_if(e.begin(), e.end(), [](double v) { return v < 0.2; })) / e.size();
         }
+        const Facing truth = FacingOf(label.keypoints_2d[kWrist], label.keypoints_2d[kIndexMcp], label.keypoints_2d[kLittleMcp], label.hand);
+        if (truth != Facing::kUnknown) {
+          const std::string& side = hand.hand.empty() ? label.hand : hand.hand;
+          r.facing_ok = FacingOf(hand.keypoints_2d[kWrist], hand.keypoints_2d[kIndexMcp], hand.keypoints_2d[kLittleMcp], side) == truth;
+        }
         if (hand.keypoints_3d.has_value() && label.keypoints_3d.has_value()) {
           r.pa_mpjpe_mm = 1000.0 * ProcrustesError(*hand.keypoints_3d, *label.keypoints_3d);
           const std::array<bool, 4> a = FingerStates(*label.keypoints_3d), b = FingerStates(*hand.keypoints_3d);
@@ -477,6 +501,7 @@ nlohmann::json ToJson(const RealScore& score) {
         h["pa_ref"] = r.label->world_3d ? "keypoints_3d_world_m (MediaPipe output)" : "keypoints_3d_camera_m";
         h["finger_agree"] = *r.finger_agree;
       }
+      h["palm_back_ok"] = r.facing_ok.has_value() ? nlohmann::json(*r.facing_ok) : nlohmann::json(nullptr);
     }
     hands.push_back(h);
   }
@@ -499,8 +524,8 @@ std::string FormatTable(const RealScore& score) {
   };
   out << std::left << std::setw(20) << "source" << std::right << std::setw(6) << "hands" << std::setw(12) << "found"
       << std::setw(10) << "PCK.1 fnd" << std::setw(10) << "PCK.2 fnd" << std::setw(10) << "PCK.2 all" << std::setw(9)
-      << "err/diag" << std::setw(11) << "handed." << std::setw(18) << "PA-MPJPE" << std::setw(10) << "fingers" << std::setw(6)
-      << "extra" << "\n";
+      << "err/diag" << std::setw(11) << "handed." << std::setw(18) << "PA-MPJPE" << std::setw(10) << "fingers" << std::setw(10)
+      << "palm/back" << std::setw(6) << "extra" << "\n";
   const auto row = [&](const std::string& name, const RealAggregate& a) {
     const std::string found = std::to_string(a.found) + " " + figure(a.found_rate().has_value() ? std::optional(100.0 * *a.found_rate()) : std::nullopt, 0) + "%";
     const std::string handed = a.handedness_n > 0 ? std::to_string(a.handedness_correct) + "/" + std::to_string(a.handedness_n) : "-";
@@ -508,10 +533,11 @@ std::string FormatTable(const RealScore& score) {
                                                            std::to_string(a.hands_with_3d_label) + ")"
                                                      : "-";
     const std::string fingers = a.finger_total > 0 ? std::to_string(a.finger_agree) + "/" + std::to_string(a.finger_total) : "-";
+    const std::string facing = a.facing_n > 0 ? std::to_string(a.facing_correct) + "/" + std::to_string(a.facing_n) : "-";
     out << std::left << std::setw(20) << name << std::right << std::setw(6) << a.hands << std::setw(12) << found << std::setw(10)
         << figure(a.pck_01_found) << std::setw(10) << figure(a.pck_02_found) << std::setw(10) << figure(a.pck_02_all)
         << std::setw(9) << figure(a.mean_norm_err_found) << std::setw(11) << handed << std::setw(18) << pa << std::setw(10)
-        << fingers << std::setw(6) << a.extra << "\n";
+        << fingers << std::setw(10) << facing << std::setw(6) << a.extra << "\n";
   };
   out << "-- ground-truth labels\n";
   for (const char* source : kGroundTruthSources) {

@@ -17,7 +17,13 @@
 //  - PA-MPJPE (mm): with 3D labels (the camera's, or for the video MediaPipe's world
 //    landmarks), after a similarity alignment without reflection;
 //  - finger states: index to little, extended iff |MCP->tip| over the finger's bone lengths
-//    exceeds 0.75, on the label's and the prediction's 3D; agreement out of 4 per hand.
+//    exceeds 0.75, on the label's and the prediction's 3D; agreement out of 4 per hand;
+//  - palm or back towards the camera (nphand's own measure; the reference has none): from
+//    the 2D keypoints and the hand's side, the sense of the turn from the wrist->index MCP
+//    ray to the wrist->little MCP ray; a right hand whose palm faces the camera turns
+//    counter-clockwise on the screen, a left one clockwise. Judged where the label's wrist
+//    and both MCPs are labelled and the label is not edge-on (the rays' sine at least
+//    kEdgeOnSine); the prediction's side is its own, or the label's when it gives none.
 // Aggregates are over hands (each hand counts once), per source, over the ground-truth
 // sources (FreiHAND, OneHand10K, Panoptic, InterHand, HaGRID) and over their one-hand and
 // two-hand images apart.
@@ -65,6 +71,16 @@ bool IsGroundTruthSource(const std::string& source);
 // right, neither keypoints nor a box.
 std::vector<RealLabel> ReadRealLabels(const std::filesystem::path& path);
 
+// Below this sine between the wrist->index MCP and wrist->little MCP rays a hand is edge-on:
+// which of its sides faces the camera is not judged.
+inline constexpr double kEdgeOnSine = 0.2;
+enum class Facing { kUnknown, kPalm, kBack };
+// Which side of a hand faces the camera, from three of its 2D keypoints (wrist, index MCP,
+// little MCP; any missing or the hand edge-on: kUnknown) and its side ("left" or "right";
+// anything else: kUnknown).
+Facing FacingOf(const std::optional<Eigen::Vector2d>& wrist, const std::optional<Eigen::Vector2d>& index_mcp,
+                const std::optional<Eigen::Vector2d>& little_mcp, const std::string& hand);
+
 struct PredictedHand {
   std::array<Eigen::Vector2d, kNumKeypoints> keypoints_2d{};  // pixels, origin at the image's top-left corner
   std::optional<Keypoints3d> keypoints_3d;                     // metres, any hand-centred frame
@@ -96,6 +112,7 @@ struct RealHandScore {
   std::optional<bool> handedness_ok;  // found hands whose prediction has a side
   std::optional<double> pa_mpjpe_mm;  // found hands with 3D on both sides
   std::optional<int> finger_agree;    // of 4
+  std::optional<bool> facing_ok;      // found hands whose label's facing is judged
   std::optional<Eigen::Vector2d> centroid;  // the partner's keypoint centroid
 };
 
@@ -107,6 +124,7 @@ struct RealAggregate {
   int pa_mpjpe_n = 0, hands_with_3d_label = 0;
   std::optional<double> pa_mpjpe_mm;
   int finger_agree = 0, finger_total = 0;
+  int facing_n = 0, facing_correct = 0;
   std::optional<double> found_rate() const { return hands > 0 ? std::optional<double>(double(found) / hands) : std::nullopt; }
 };
 
