@@ -296,6 +296,61 @@ TEST(SkinTest, AHandInFrontOfAFaceKeepsWhatItsOutlinePartsFromTheFace) {
   EXPECT_LT(cv::countNonZero(skin & hand & ~Regions(s)), 0.03 * cv::countNonZero(hand));
 }
 
+// A person in a skin-coloured sweater behind the hand: the body below the face is set
+// aside, the hand and its arm stay regions.
+TEST(SkinTest, ABodyInASkinColouredSweaterIsSetAsideAndTheHandStays) {
+  for (const auto& [seed, at] : {std::pair{12u, 0}, std::pair{13u, 60}}) {
+    SequenceOptions options = testing::DemoSequence(seed);
+    options.sweater = true;
+    Sequence sequence(testing::RightHand(), options);
+    const SequenceFrame frame = sequence.Render(at);
+    cv::Mat arm = (frame.labels == static_cast<int>(PixelLabel::kHand)) | (frame.labels == static_cast<int>(PixelLabel::kForearm));
+    const cv::Mat hand = frame.labels == static_cast<int>(PixelLabel::kHand);
+    cv::dilate(arm, arm, cv::Mat(), cv::Point(-1, -1), 4);
+    // Of the regions' pixels, those away from the hand and arm; and the share of the hand's
+    // pixels in the regions.
+    auto segment = [&](bool set_aside_bodies, int* body_pixels) {
+      SkinOptions skin;
+      skin.set_aside_bodies = set_aside_bodies;
+      SkinSegmenter segmenter(skin);
+      const SkinSegmentation s = segmenter.Segment(frame.rgb);
+      EXPECT_EQ(s.faces.size(), 1u) << seed;
+      *body_pixels = s.body_pixels;
+      const cv::Mat regions = Regions(s);
+      return std::pair{cv::countNonZero(regions & ~arm), static_cast<double>(cv::countNonZero(regions & hand)) / cv::countNonZero(hand)};
+    };
+    int body = 0, kept_body = 0;
+    const auto [astray, hand_share] = segment(true, &body);
+    const auto [astray_kept, hand_share_kept] = segment(false, &kept_body);
+    EXPECT_GT(body, 10000) << seed;
+    EXPECT_EQ(kept_body, 0) << seed;
+    EXPECT_GT(astray_kept, 10000) << seed << ": the sweater is skin-coloured";
+    EXPECT_LT(astray, 0.05 * astray_kept) << seed;
+    EXPECT_NEAR(hand_share, hand_share_kept, 1e-9) << seed;
+    EXPECT_GT(hand_share, 0.8) << seed;
+  }
+}
+
+// Two arms raised from the frame's bottom below a face, as far apart as shoulders, are no
+// body: each is taller than wide.
+TEST(SkinTest, ArmsRaisedBelowAFaceAreNoBody) {
+  cv::Mat frame = MakeBackground(BackgroundKind::kClutter, cv::Size(640, 480), testing::kTestSeed);
+  const cv::Vec3f skin = SkinToneByName("light").bgr;
+  DrawFace(skin, cv::Point(320, 140), 200, &frame);
+  const cv::Scalar colour(skin[0], skin[1], skin[2]);
+  for (int x : {140, 500}) {
+    cv::rectangle(frame, cv::Rect(x - 30, 300, 60, 180), colour, cv::FILLED);
+    cv::ellipse(frame, cv::Point(x, 290), cv::Size(45, 60), 0.0, 0.0, 360.0, colour, cv::FILLED);
+  }
+  SkinSegmenter segmenter;
+  const SkinSegmentation s = segmenter.Segment(frame);
+  ASSERT_EQ(s.faces.size(), 1u);
+  EXPECT_EQ(s.body_pixels, 0);
+  for (const cv::Point arm : {cv::Point(140, 400), cv::Point(500, 400)}) {
+    EXPECT_TRUE(std::any_of(s.regions.begin(), s.regions.end(), [&](const SkinRegion& r) { return r.box.contains(arm); })) << arm;
+  }
+}
+
 TEST(SkinTest, BadInputIsRefused) {
   SkinSegmenter segmenter(NoFaces());
   testing::ExpectError([&] { segmenter.Segment(cv::Mat()); }, "8-bit BGR");

@@ -409,6 +409,7 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {
   if (candidates.empty()) {
     result.status = FrameStatus::kNoSkin;
     result.reason = skin.colourless         ? "the frame has no colour (greyscale): skin cannot be told by its colour"
+                    : skin.body_pixels > 0 ? "only faces and the bodies below them are skin-coloured"
                     : skin.face_pixels > 0 ? "only faces are skin-coloured"
                                            : "no skin-coloured region";
     carried_.clear();

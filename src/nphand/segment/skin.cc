@@ -387,6 +387,34 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   auto beside_front = [&](const cv::Rect& box) {
     return std::any_of(reaches.begin(), reaches.end(), [&](const cv::Rect& r) { return (r & box).area() > 0; });
   };
+  // A body dressed in skin colours below a face (a sweater, a bare chest; the neck's
+  // rectangle and a sweater's ribs may split it): the regions that meet the frame's bottom
+  // edge within the face's column, grown by the face's width each side, over at least
+  // kBodyPiece of its width each, when together they span at least kBodyWidths of it. An
+  // arm entering from the bottom spans about its wrist's width.
+  std::vector<uint8_t> body(stats.size(), 0);
+  if (!faces_.empty() && options_.set_aside_bodies) {
+    const int* bottom = out.labels.ptr<int>(work.rows - 1);
+    for (const cv::Rect& face : faces_) {
+      const cv::Rect f = working_box(face);
+      const int from = std::max(0, f.x - f.width), to = std::min(work.cols, f.x + 2 * f.width);
+      std::vector<int> met(stats.size(), 0);
+      for (int x = from; x < to; ++x) ++met[bottom[x]];
+      int left = to, right = from;
+      for (int x = from; x < to; ++x) {
+        if (bottom[x] == 0 || met[bottom[x]] < kBodyPiece * f.width || stats[bottom[x]].box.height > kBodyHeight * met[bottom[x]]) continue;
+        left = std::min(left, x);
+        right = std::max(right, x + 1);
+      }
+      if (right - left < kBodyWidths * f.width) continue;
+      for (size_t label = 1; label < stats.size(); ++label) {
+        if (met[label] >= kBodyPiece * f.width && stats[label].box.height <= kBodyHeight * met[label] &&
+            (before_face.empty() || before_face[label] == 0)) {
+          body[label] = 1;
+        }
+      }
+    }
+  }
   const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
   for (size_t label = 1; label < stats.size(); ++label) {
     const RegionStats& found = stats[label];
@@ -394,6 +422,10 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     if (!near_face.empty() && before_face[label] == 0 && near_face[label] >= 0.8 * found.area &&
         !beside_front(found.box)) {
       out.face_pixels += found.area * scale * scale;
+      continue;
+    }
+    if (body[label] != 0) {
+      out.body_pixels += found.area * scale * scale;
       continue;
     }
     SkinRegion region;

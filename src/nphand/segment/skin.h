@@ -51,6 +51,10 @@ struct SkinOptions {
   // smaller than a hand, are something in front of the face and stay skin; the rest, and
   // the neck, are the face's.
   bool part_faces = true;
+  // A body dressed in skin colours below a face (a sweater, a bare chest): the regions that
+  // meet the frame's bottom edge below a face, spanning at least kBodyWidths of its width
+  // together, are set aside as no hand.
+  bool set_aside_bodies = true;
   bool Check(std::string* why) const;
 };
 
@@ -74,6 +78,7 @@ struct SkinSegmentation {
   std::vector<SkinRegion> regions;  // at least min_area, largest first
   std::vector<cv::Rect> faces;      // the faces in view (the last look's, followed since), frame pixels
   int face_pixels = 0;              // frame pixels of skin set aside as faces (heads, necks and what they leave of them)
+  int body_pixels = 0;              // frame pixels of skin set aside as bodies below faces (SkinOptions::set_aside_bodies)
   bool faces_looked = false;        // the face cascade ran on this frame
   // A frame without regions that has no colour (greyscale, or an infrared camera's): every
   // pixel's chroma lies within kColourlessChroma of grey, so skin colour cannot be told from
@@ -116,6 +121,9 @@ class SkinSegmenter {
   static constexpr int kFollowSide = 24;
   static constexpr double kFollowScore = 0.5;  // normalised correlation a followed face must reach
   static constexpr double kInFrontShare = 0.15;  // least piece in front of a face, of its box
+  static constexpr double kBodyWidths = 1.25;    // a body's least span along the frame's bottom edge, in faces
+  static constexpr double kBodyPiece = 0.25;     // a body's piece's least width along that edge, in faces
+  static constexpr double kBodyHeight = 3.0;     // a body's piece's greatest height, in its width along that edge (an arm is taller)
   struct FaceDetector;
   std::shared_ptr<FaceDetector> detector_;
 };
