@@ -388,10 +388,11 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     return std::any_of(reaches.begin(), reaches.end(), [&](const cv::Rect& r) { return (r & box).area() > 0; });
   };
   // A body dressed in skin colours below a face (a sweater, a bare chest; the neck's
-  // rectangle and a sweater's ribs may split it): the regions that meet the frame's bottom
-  // edge within the face's column, grown by the face's width each side, over at least
-  // kBodyPiece of its width each, when together they span at least kBodyWidths of it. An
-  // arm entering from the bottom spans about its wrist's width.
+  // rectangle, a sweater's ribs and the frame's side may split it): the pieces that meet the
+  // frame's bottom edge within the face's column, grown by the face's width each side, each
+  // over at least kBodyPiece of the face's width and at most kBodyHeight times as tall as
+  // that, when together they span at least kBodyWidths of it. An arm raised from the bottom
+  // meets it over its wrist's width and is taller than that.
   std::vector<uint8_t> body(stats.size(), 0);
   if (!faces_.empty() && options_.set_aside_bodies) {
     const int* bottom = out.labels.ptr<int>(work.rows - 1);
@@ -400,19 +401,18 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
       const int from = std::max(0, f.x - f.width), to = std::min(work.cols, f.x + 2 * f.width);
       std::vector<int> met(stats.size(), 0);
       for (int x = from; x < to; ++x) ++met[bottom[x]];
+      auto piece = [&](int label) {
+        return label != 0 && met[label] >= kBodyPiece * f.width && stats[label].box.height <= kBodyHeight * met[label] &&
+               (before_face.empty() || before_face[label] == 0);
+      };
       int left = to, right = from;
       for (int x = from; x < to; ++x) {
-        if (bottom[x] == 0 || met[bottom[x]] < kBodyPiece * f.width || stats[bottom[x]].box.height > kBodyHeight * met[bottom[x]]) continue;
+        if (!piece(bottom[x])) continue;
         left = std::min(left, x);
         right = std::max(right, x + 1);
       }
       if (right - left < kBodyWidths * f.width) continue;
-      for (size_t label = 1; label < stats.size(); ++label) {
-        if (met[label] >= kBodyPiece * f.width && stats[label].box.height <= kBodyHeight * met[label] &&
-            (before_face.empty() || before_face[label] == 0)) {
-          body[label] = 1;
-        }
-      }
+      for (size_t label = 1; label < stats.size(); ++label) body[label] |= piece(static_cast<int>(label));
     }
   }
   const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
