@@ -109,6 +109,36 @@ TEST_F(PoseErrorsTest, APartRunOrAnotherSequenceIsRefused) {
   testing::ExpectError([&] { ComparePoses(dir / "truth.jsonl", Write(dir / "long.jsonl", poses)); }, "has 10 frames");
 }
 
+// The side of the hand towards the camera: an estimate mirrored left to right shows the
+// other side; an edge-on truth, or lines without a side, are not judged.
+TEST_F(PoseErrorsTest, ThePalmOrBackTowardsTheCameraIsJudgedFromTheKeypointsAndTheSide) {
+  const auto dir = testing::ScratchDir();
+  std::vector<Eigen::Vector3d> palm(kNumKeypoints, Eigen::Vector3d::Zero()), mirrored, edge_on;
+  for (int k = 1; k < kNumKeypoints; ++k) palm[k] = Eigen::Vector3d(0.002 * k, -0.09, 0.0);
+  palm[5] = Eigen::Vector3d(0.02, -0.08, 0.0);    // index MCP on the right of the screen: a right palm
+  palm[17] = Eigen::Vector3d(-0.02, -0.07, 0.0);  // little MCP on the left
+  for (const Eigen::Vector3d& k : palm) mirrored.push_back(Eigen::Vector3d(-k.x(), k.y(), k.z()));
+  edge_on = palm;
+  edge_on[17] = Eigen::Vector3d(0.019, -0.07, 0.0);
+  std::vector<nlohmann::json> truth, poses;
+  const std::vector<std::pair<const std::vector<Eigen::Vector3d>*, const std::vector<Eigen::Vector3d>*>> frames = {
+      {&palm, &palm}, {&palm, &mirrored}, {&edge_on, &mirrored}, {&palm, &palm}};
+  for (size_t f = 0; f < frames.size(); ++f) {
+    truth.push_back(Line(static_cast<int>(f), true, *frames[f].first));
+    poses.push_back(Line(static_cast<int>(f), true, *frames[f].second));
+    if (f < 3) truth.back()["hand"] = poses.back()["hand"] = "right";
+  }
+  const PoseErrorSummary s = ComparePoses(Write(dir / "truth.jsonl", truth), Write(dir / "poses.jsonl", poses));
+  EXPECT_TRUE(*s.frames[0].palm_back_ok);
+  EXPECT_FALSE(*s.frames[1].palm_back_ok);
+  EXPECT_FALSE(s.frames[2].palm_back_ok.has_value()) << "the truth edge-on";
+  EXPECT_FALSE(s.frames[3].palm_back_ok.has_value()) << "no side";
+  EXPECT_EQ(s.palm_back_judged, 2);
+  EXPECT_EQ(s.palm_back_right, 1);
+  EXPECT_EQ(ToJson(s)["palm_back_right"], 1);
+  EXPECT_NE(FormatTable(s).find("right in 1 of 2"), std::string::npos);
+}
+
 TEST_F(PoseErrorsTest, NothingDetectedReadsAsNothingMeasuredNotAsPerfect) {
   const auto dir = testing::ScratchDir();
   std::vector<nlohmann::json> truth, poses;

@@ -1,11 +1,16 @@
 // Today's hand-pose measures (HO-3D, DexYCB, FreiHAND), on the 21 keypoints in metres:
 // MPJPE about the root, PA-MPJPE after a similarity Procrustes alignment, the fraction of
-// keypoints within a distance and the area under that curve, and jitter. The paper's own
+// keypoints within a distance and the area under that curve, jitter; and, from 2D keypoints,
+// which side of the hand faces the camera. The paper's own
 // measures (pose-vector error, keypoints about the wrist) are in pose_errors.h.
 #pragma once
 
+#include <optional>
 #include <span>
+#include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "nphand/model/hand_model.h"
 
@@ -34,6 +39,17 @@ double FractionWithin(std::span<const double> distances, double threshold);
 // (`steps` + 1 of them, trapezoids), divided by max: 1 when every distance is 0, 0 when
 // none is within max. FreiHAND's AUC over 0–50 mm is AreaUnderCurve(d, 0.05).
 double AreaUnderCurve(std::span<const double> distances, double max, int steps = 100);
+
+// Below this sine between the wrist->index MCP and wrist->little MCP rays a hand is edge-on:
+// which of its sides faces the camera is not judged.
+inline constexpr double kEdgeOnSine = 0.2;
+enum class Facing { kUnknown, kPalm, kBack };
+// Which side of a hand faces the camera, from three of its 2D keypoints (pixels, y down:
+// wrist, index MCP, little MCP; any missing or the hand edge-on: kUnknown) and its side
+// ("left" or "right"; anything else: kUnknown). The turn from the wrist->index MCP ray to
+// the wrist->little MCP ray looks counter-clockwise for a right palm and for a left back.
+Facing FacingOf(const std::optional<Eigen::Vector2d>& wrist, const std::optional<Eigen::Vector2d>& index_mcp,
+                const std::optional<Eigen::Vector2d>& little_mcp, const std::string& hand);
 
 // Mean over frames and keypoints of the second difference |k(t+1) - 2 k(t) + k(t-1)|:
 // acceleration in metres per frame squared (0 for fewer than 3 frames). Compare an

@@ -122,6 +122,19 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
         e.keypoint_px += std::hypot(k2[k][0] - t2[k][0], k2[k][1] - t2[k][1]) / kNumKeypoints;
       }
       e.pa_mpjpe_mm = 1000.0 * ProcrustesError(estimate, truth_hand);
+      // A line without a side (older files) is not judged.
+      auto facing = [&](const Points2& k, const nlohmann::json& line) {
+        const auto side = line.find("hand");
+        if (side == line.end() || !side->is_string()) return Facing::kUnknown;
+        return FacingOf(Eigen::Vector2d(k[0][0], k[0][1]), Eigen::Vector2d(k[5][0], k[5][1]), Eigen::Vector2d(k[17][0], k[17][1]),
+                        side->get<std::string>());
+      };
+      const Facing true_facing = facing(t2, t);
+      if (true_facing != Facing::kUnknown) {
+        e.palm_back_ok = facing(k2, p) == true_facing;
+        ++summary.palm_back_judged;
+        summary.palm_back_right += *e.palm_back_ok;
+      }
       estimated.push_back(estimate);
       true_keypoints.push_back(truth_hand);
       detected_frames.push_back(e.frame);
@@ -181,6 +194,7 @@ nlohmann::json ToJson(const PoseErrorSummary& summary) {
       f["keypoint_px"] = e.keypoint_px;
       f["camera_mm"] = e.camera_mm;
       f["pa_mpjpe_mm"] = e.pa_mpjpe_mm;
+      f["palm_back_ok"] = e.palm_back_ok.has_value() ? nlohmann::json(*e.palm_back_ok) : nlohmann::json(nullptr);
     }
     frames.push_back(f);
   }
@@ -192,6 +206,8 @@ nlohmann::json ToJson(const PoseErrorSummary& summary) {
           {"auc_0_50", JsonNumber(summary.auc_0_50)},
           {"jitter_mm", JsonNumber(summary.jitter_mm)},
           {"truth_jitter_mm", JsonNumber(summary.truth_jitter_mm)},
+          {"palm_back_judged", summary.palm_back_judged},
+          {"palm_back_right", summary.palm_back_right},
           {"per_frame", frames}};
 }
 
@@ -206,6 +222,8 @@ std::string FormatTable(const PoseErrorSummary& summary) {
   out << "keypoints within 20 mm " << Figure(summary.within_20mm) << ", AUC 0-50 mm " << Figure(summary.auc_0_50) << "\n";
   out << "jitter " << Figure(summary.jitter_mm) << " mm/frame^2 (the truth's own " << Figure(summary.truth_jitter_mm)
       << "; over runs of three detected frames)\n";
+  out << "palm or back towards the camera right in " << summary.palm_back_right << " of " << summary.palm_back_judged
+      << " detected frames (the rest edge-on)\n";
   return out.str();
 }
 

@@ -2,10 +2,12 @@
 // wrote (poses.jsonl) against what `nphand sequence` rendered (truth.jsonl), in the paper's
 // measures (joint angles; 3D joint positions about the wrist, which the paper prefers, Fig. 8)
 // and today's (wrist rotation, 2D keypoints in pixels, 3D keypoints in the camera frame,
-// PA-MPJPE, the fraction within 20 mm and the AUC over 0-50 mm, jitter; measures.h).
+// PA-MPJPE, the fraction within 20 mm and the AUC over 0-50 mm, jitter, the side of the
+// hand towards the camera; measures.h).
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,9 @@ struct FramePoseError {
   double keypoint_px = 0.0;  // mean 2D keypoint distance in the frame
   double camera_mm = 0.0;    // mean 3D keypoint distance in the camera frame
   double pa_mpjpe_mm = 0.0;  // keypoint_mm's keypoints after a similarity (Procrustes) alignment
+  // Whether the estimate has the truth's side of the hand towards the camera (FacingOf on
+  // each one's 2D keypoints and side; empty when the truth's is edge-on).
+  std::optional<bool> palm_back_ok;
 };
 
 struct PoseErrorSummary {
@@ -40,6 +45,8 @@ struct PoseErrorSummary {
   // detected frames in a row: the estimate's and the truth's own over the same frames.
   double jitter_mm = 0.0;
   double truth_jitter_mm = 0.0;
+  // Detected frames whose side towards the camera is judged, and those the estimate has right.
+  int palm_back_judged = 0, palm_back_right = 0;
 };
 
 // Reads both files (one JSON object per line, the same frames in the same order, as many in

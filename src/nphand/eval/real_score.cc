@@ -240,18 +240,6 @@ nlohmann::json ToJson(const RealAggregate& a) {
 
 }  // namespace
 
-Facing FacingOf(const std::optional<Eigen::Vector2d>& wrist, const std::optional<Eigen::Vector2d>& index_mcp,
-                const std::optional<Eigen::Vector2d>& little_mcp, const std::string& hand) {
-  if (!wrist || !index_mcp || !little_mcp || (hand != "left" && hand != "right")) return Facing::kUnknown;
-  const Eigen::Vector2d a = *index_mcp - *wrist, b = *little_mcp - *wrist;
-  const double lengths = a.norm() * b.norm();
-  if (lengths <= 0.0) return Facing::kUnknown;
-  // Image y points down: a turn that looks counter-clockwise has a negative cross product.
-  const double sine = (a.x() * b.y() - a.y() * b.x()) / lengths;
-  if (std::abs(sine) < kEdgeOnSine) return Facing::kUnknown;
-  return (sine < 0.0) == (hand == "right") ? Facing::kPalm : Facing::kBack;
-}
-
 std::string RealSourceOf(const std::string& file) {
   const std::string base = std::filesystem::path(file).filename().string();
   if (file.rfind("videos/", 0) == 0 || base.rfind("asl_hand", 0) == 0) return "asl_video";

@@ -22,8 +22,8 @@
 //    the 2D keypoints and the hand's side, the sense of the turn from the wrist->index MCP
 //    ray to the wrist->little MCP ray; a right hand whose palm faces the camera turns
 //    counter-clockwise on the screen, a left one clockwise. Judged where the label's wrist
-//    and both MCPs are labelled and the label is not edge-on (the rays' sine at least
-//    kEdgeOnSine); the prediction's side is its own, or the label's when it gives none.
+//    and both MCPs are labelled and the label is not edge-on (FacingOf, measures.h); the
+//    prediction's side is its own, or the label's when it gives none.
 // Aggregates are over hands (each hand counts once), per source, over the ground-truth
 // sources (FreiHAND, OneHand10K, Panoptic, InterHand, HaGRID) and over their one-hand and
 // two-hand images apart.
@@ -39,6 +39,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include "nphand/eval/measures.h"
 #include "nphand/model/hand_model.h"
 
 namespace nphand {
@@ -70,16 +71,6 @@ bool IsGroundTruthSource(const std::string& source);
 // no `file`, keypoints not 21 [x, y] (or null), 3D not 21 [x, y, z], a side not left or
 // right, neither keypoints nor a box.
 std::vector<RealLabel> ReadRealLabels(const std::filesystem::path& path);
-
-// Below this sine between the wrist->index MCP and wrist->little MCP rays a hand is edge-on:
-// which of its sides faces the camera is not judged.
-inline constexpr double kEdgeOnSine = 0.2;
-enum class Facing { kUnknown, kPalm, kBack };
-// Which side of a hand faces the camera, from three of its 2D keypoints (wrist, index MCP,
-// little MCP; any missing or the hand edge-on: kUnknown) and its side ("left" or "right";
-// anything else: kUnknown).
-Facing FacingOf(const std::optional<Eigen::Vector2d>& wrist, const std::optional<Eigen::Vector2d>& index_mcp,
-                const std::optional<Eigen::Vector2d>& little_mcp, const std::string& hand);
 
 struct PredictedHand {
   std::array<Eigen::Vector2d, kNumKeypoints> keypoints_2d{};  // pixels, origin at the image's top-left corner
