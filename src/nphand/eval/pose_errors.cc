@@ -223,7 +223,7 @@ std::string FormatTable(const PoseErrorSummary& summary) {
   out << "jitter " << Figure(summary.jitter_mm) << " mm/frame^2 (the truth's own " << Figure(summary.truth_jitter_mm)
       << "; over runs of three detected frames)\n";
   out << "palm or back towards the camera right in " << summary.palm_back_right << " of " << summary.palm_back_judged
-      << " detected frames (the rest edge-on)\n";
+      << " judged detected frames (the others edge-on or without a side)\n";
   return out.str();
 }
 

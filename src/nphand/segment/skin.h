@@ -52,8 +52,9 @@ struct SkinOptions {
   // the neck, are the face's.
   bool part_faces = true;
   // A body dressed in skin colours below a face (a sweater, a bare chest): the regions that
-  // meet the frame's bottom edge below a face, spanning at least kBodyWidths of its width
-  // together, are set aside as no hand.
+  // meet the frame's bottom edge below a face, each over at least kBodyPiece face widths
+  // and at most kBodyHeight times as tall as that, and together span at least kBodyWidths
+  // face widths, are set aside as no hand.
   bool set_aside_bodies = true;
   bool Check(std::string* why) const;
 };
