@@ -73,6 +73,7 @@ TEST_F(EstimatorStudyTest, RunsTheNamedSettingsOverTheSequences) {
     EXPECT_EQ(s.frames, 8) << s.name;
     EXPECT_LE(s.detected, s.frames);
     EXPECT_LE(s.both_turns, s.detected);
+    EXPECT_LE(s.flipped, s.detected);
     EXPECT_GE(s.keypoint_mm, 0.0);
   }
   EXPECT_EQ(scores[1].name, "turns0");
@@ -83,6 +84,7 @@ TEST_F(EstimatorStudyTest, RunsTheNamedSettingsOverTheSequences) {
   EXPECT_EQ(json.size(), 3u);
   EXPECT_TRUE(json[0].contains("both_turns"));
   EXPECT_TRUE(json[0].contains("jitter_mm"));
+  EXPECT_TRUE(json[0].contains("flipped"));
   EXPECT_NE(FormatTable(scores).find("turns0.3"), std::string::npos);
 
   options.settings = {"nonesuch"};

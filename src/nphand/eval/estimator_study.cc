@@ -248,6 +248,10 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
         const double wrist = RotationAngleDeg(r.pose.camera_from_hand, truth.pose.camera_from_hand);
         score.wrist_deg += wrist;
         score.turned += wrist >= kTurnedDeg;
+        const auto& k = truth.keypoints_2d;
+        const Facing true_facing = FacingOf(k[0], k[5], k[17], ToString(truth.pose.handedness));
+        score.flipped += true_facing != Facing::kUnknown &&
+                         FacingOf(r.keypoints_2d[0], r.keypoints_2d[5], r.keypoints_2d[17], ToString(r.hand)) != true_facing;
         score.keypoint_mm += 1000.0 * keypoint;
         score.keypoint_px += px / kNumKeypoints;
         score.camera_mm += 1000.0 * camera / kNumKeypoints;
@@ -286,6 +290,7 @@ nlohmann::json ToJson(const std::vector<EstimatorScore>& scores) {
                     {"detected", s.detected},
                     {"both_turns", s.both_turns},
                     {"turned", s.turned},
+                    {"flipped", s.flipped},
                     {"joint_deg", s.joint_deg},
                     {"wrist_deg", s.wrist_deg},
                     {"keypoint_mm", s.keypoint_mm},
@@ -302,7 +307,7 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
   std::ostringstream out;
   out << std::left << std::setw(22) << "setting" << std::right << std::setw(10) << "detected" << std::setw(10)
       << "joint_deg" << std::setw(10) << "wrist_deg" << std::setw(12) << "keypoint_mm" << std::setw(12) << "keypoint_px"
-      << std::setw(11) << "camera_mm" << std::setw(8) << "jitter" << std::setw(8) << "ms" << std::setw(8) << "2turns" << std::setw(8) << "turned" << std::setw(5) << "lag" << "\n";
+      << std::setw(11) << "camera_mm" << std::setw(8) << "jitter" << std::setw(8) << "ms" << std::setw(8) << "2turns" << std::setw(8) << "turned" << std::setw(8) << "flipped" << std::setw(5) << "lag" << "\n";
   out << std::fixed;
   for (const EstimatorScore& s : scores) {
     out << std::left << std::setw(22) << s.name << std::right << std::setw(10)
@@ -310,7 +315,7 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
         << s.joint_deg << std::setw(10) << s.wrist_deg << std::setprecision(1) << std::setw(12) << s.keypoint_mm
         << std::setw(12) << s.keypoint_px << std::setw(11) << s.camera_mm << std::setw(8) << s.jitter_mm
         << std::setprecision(2) << std::setw(8) << s.ms_median << std::setprecision(0) << std::setw(7)
-        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%" << std::setw(8) << s.turned << std::setw(5) << s.lag_frames << "\n";
+        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%" << std::setw(8) << s.turned << std::setw(8) << s.flipped << std::setw(5) << s.lag_frames << "\n";
   }
   return out.str();
 }

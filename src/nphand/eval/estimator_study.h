@@ -53,6 +53,7 @@ struct EstimatorScore {
   int detected = 0;            // frames with an estimate
   int both_turns = 0;          // of which searched the half-turned crop too
   int turned = 0;              // of which with the wrist turned about a half turn: at least kTurnedDeg from the truth
+  int flipped = 0;             // of which, the truth not edge-on, with the other side of the hand towards the camera (FacingOf)
   double joint_deg = 0.0;      // mean absolute joint-angle error, mean over detected frames
   double wrist_deg = 0.0;      // wrist rotation error, mean
   double keypoint_mm = 0.0;    // mean 3D keypoint error about the wrist (the paper's joint-position measure)
