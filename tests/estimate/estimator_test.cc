@@ -385,8 +385,8 @@ TEST_F(EstimatorTest, AHandBesideAFaceIsFound) {
 }
 
 // Over every `step`-th frame of the demo's settings with `seeds`, each from a fresh
-// estimator: the estimates, and those whose box lies mostly (over a fifth) off the hand and
-// its arm.
+// estimator: the estimates, and those whose box lies more than a fifth outside the box of
+// the hand and its arm.
 std::pair<int, int> EstimatesOffTheArm(const Database& db, const KnnIndex& index, const EstimatorOptions& options,
                                        std::initializer_list<uint64_t> seeds, bool sweater, int step) {
   int detected = 0, off = 0;
