@@ -239,7 +239,7 @@ TEST(RealScoreTest, FiguresAreTheReferenceScorersOnTheSamePredictions) {
   // The fingerspelling video shows a right palm throughout: the facing's sense on a real hand.
   for (const RealLabel& label : labels) {
     if (label.source != "asl_video") continue;
-    EXPECT_EQ(FacingOf(label.keypoints_2d[0], label.keypoints_2d[5], label.keypoints_2d[17], label.hand), Facing::kPalm)
+    EXPECT_EQ(FacingOf(label.keypoints_2d, label.hand), Facing::kPalm)
         << "frame " << *label.frame;
   }
   const std::vector<RealPrediction> predictions = SpoiledPredictions(labels);

@@ -248,10 +248,8 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
         const double wrist = RotationAngleDeg(r.pose.camera_from_hand, truth.pose.camera_from_hand);
         score.wrist_deg += wrist;
         score.turned += wrist >= kTurnedDeg;
-        const auto& k = truth.keypoints_2d;
-        const Facing true_facing = FacingOf(k[0], k[5], k[17], ToString(truth.pose.handedness));
-        score.flipped += true_facing != Facing::kUnknown &&
-                         FacingOf(r.keypoints_2d[0], r.keypoints_2d[5], r.keypoints_2d[17], ToString(r.hand)) != true_facing;
+        const Facing true_facing = FacingOf(truth.keypoints_2d, ToString(truth.pose.handedness));
+        score.flipped += true_facing != Facing::kUnknown && FacingOf(r.keypoints_2d, ToString(r.hand)) != true_facing;
         score.keypoint_mm += 1000.0 * keypoint;
         score.keypoint_px += px / kNumKeypoints;
         score.camera_mm += 1000.0 * camera / kNumKeypoints;

@@ -17,6 +17,9 @@ double Median(std::vector<double> values) {
 }
 namespace {
 
+// The standard keypoints FacingOf reads.
+constexpr int kWristKeypoint = 0, kIndexMcpKeypoint = 5, kLittleMcpKeypoint = 17;
+
 Eigen::Matrix3Xd Columns(const Keypoints3d& keypoints) {
   Eigen::Matrix3Xd m(3, kNumKeypoints);
   for (int k = 0; k < kNumKeypoints; ++k) m.col(k) = keypoints[k];
@@ -99,6 +102,14 @@ Facing FacingOf(const std::optional<Eigen::Vector2d>& wrist, const std::optional
   const double sine = (a.x() * b.y() - a.y() * b.x()) / lengths;
   if (std::abs(sine) < kEdgeOnSine) return Facing::kUnknown;
   return (sine < 0.0) == (hand == "right") ? Facing::kPalm : Facing::kBack;
+}
+
+Facing FacingOf(const std::array<std::optional<Eigen::Vector2d>, kNumKeypoints>& keypoints, const std::string& hand) {
+  return FacingOf(keypoints[kWristKeypoint], keypoints[kIndexMcpKeypoint], keypoints[kLittleMcpKeypoint], hand);
+}
+
+Facing FacingOf(const std::array<Eigen::Vector2d, kNumKeypoints>& keypoints, const std::string& hand) {
+  return FacingOf(keypoints[kWristKeypoint], keypoints[kIndexMcpKeypoint], keypoints[kLittleMcpKeypoint], hand);
 }
 
 }  // namespace nphand

@@ -5,6 +5,7 @@
 // measures (pose-vector error, keypoints about the wrist) are in pose_errors.h.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <span>
 #include <string>
@@ -50,6 +51,10 @@ enum class Facing { kUnknown, kPalm, kBack };
 // the wrist->little MCP ray looks counter-clockwise for a right palm and for a left back.
 Facing FacingOf(const std::optional<Eigen::Vector2d>& wrist, const std::optional<Eigen::Vector2d>& index_mcp,
                 const std::optional<Eigen::Vector2d>& little_mcp, const std::string& hand);
+// The same from a hand's 21 keypoints in the standard order (a label's, some unlabelled; or
+// an estimate's).
+Facing FacingOf(const std::array<std::optional<Eigen::Vector2d>, kNumKeypoints>& keypoints, const std::string& hand);
+Facing FacingOf(const std::array<Eigen::Vector2d, kNumKeypoints>& keypoints, const std::string& hand);
 
 // Mean over frames and keypoints of the second difference |k(t+1) - 2 k(t) + k(t-1)|:
 // acceleration in metres per frame squared (0 for fewer than 3 frames). Compare an

@@ -123,11 +123,12 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
       }
       e.pa_mpjpe_mm = 1000.0 * ProcrustesError(estimate, truth_hand);
       // A line without a side (older files) is not judged.
-      auto facing = [&](const Points2& k, const nlohmann::json& line) {
+      auto facing = [&](const Points2& points, const nlohmann::json& line) {
         const auto side = line.find("hand");
         if (side == line.end() || !side->is_string()) return Facing::kUnknown;
-        return FacingOf(Eigen::Vector2d(k[0][0], k[0][1]), Eigen::Vector2d(k[5][0], k[5][1]), Eigen::Vector2d(k[17][0], k[17][1]),
-                        side->get<std::string>());
+        std::array<Eigen::Vector2d, kNumKeypoints> keypoints;
+        for (int k = 0; k < kNumKeypoints; ++k) keypoints[k] = Eigen::Vector2d(points[k][0], points[k][1]);
+        return FacingOf(keypoints, side->get<std::string>());
       };
       const Facing true_facing = facing(t2, t);
       if (true_facing != Facing::kUnknown) {

@@ -21,7 +21,6 @@ constexpr std::array<const char*, 5> kGroundTruthSources = {"freihand", "onehand
 constexpr std::array<const char*, 3> kMediaPipeSources = {"tfjs_hands", "mediapipe_thumbs_up", "asl_video"};
 constexpr double kGrow = 0.25;
 constexpr double kExtendedRatio = 0.75;
-constexpr int kWrist = 0, kIndexMcp = 5, kLittleMcp = 17;
 constexpr std::array<std::array<int, 4>, 4> kFingers = {{{5, 6, 7, 8}, {9, 10, 11, 12}, {13, 14, 15, 16}, {17, 18, 19, 20}}};
 
 std::string Stem(const std::string& file) { return std::filesystem::path(file).stem().string(); }
@@ -412,11 +411,8 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
           r.pck_01 = static_cast<double>(std::count_if(e.begin(), e.end(), [](double v) { return v < 0.1; })) / e.size();
           r.pck_02 = static_cast<double>(std::count_if(e.begin(), e.end(), [](double v) { return v < 0.2; })) / e.size();
         }
-        const Facing truth = FacingOf(label.keypoints_2d[kWrist], label.keypoints_2d[kIndexMcp], label.keypoints_2d[kLittleMcp], label.hand);
-        if (truth != Facing::kUnknown) {
-          const std::string& side = hand.hand.empty() ? label.hand : hand.hand;
-          r.facing_ok = FacingOf(hand.keypoints_2d[kWrist], hand.keypoints_2d[kIndexMcp], hand.keypoints_2d[kLittleMcp], side) == truth;
-        }
+        const Facing truth = FacingOf(label.keypoints_2d, label.hand);
+        if (truth != Facing::kUnknown) r.facing_ok = FacingOf(hand.keypoints_2d, hand.hand.empty() ? label.hand : hand.hand) == truth;
         if (hand.keypoints_3d.has_value() && label.keypoints_3d.has_value()) {
           r.pa_mpjpe_mm = 1000.0 * ProcrustesError(*hand.keypoints_3d, *label.keypoints_3d);
           const std::array<bool, 4> a = FingerStates(*label.keypoints_3d), b = FingerStates(*hand.keypoints_3d);
