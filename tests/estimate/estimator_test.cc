@@ -351,6 +351,15 @@ TEST_F(EstimatorTest, FramesWithoutAHandSaySo) {
   r = estimator.Process(sliver, 0.0);
   EXPECT_EQ(r.status, FrameStatus::kNotAHand);
   EXPECT_NE(r.reason.find("too thin for a hand"), std::string::npos) << r.reason;
+  // A speck of skin (a patch far smaller than any hand the frame could show) is not looked up.
+  cv::Mat speck = wall.clone();
+  cv::rectangle(speck, cv::Rect(2, 200, 19, 8), SkinToneByName("olive").bgr, cv::FILLED);
+  estimator.Reset();
+  r = estimator.Process(speck, 0.0);
+  EXPECT_EQ(r.status, FrameStatus::kNoSkin);
+  EXPECT_EQ(r.reason.rfind("no skin-coloured region of a hand's size (the largest spans ", 0), 0u) << r.reason;
+  EXPECT_NE(r.reason.find("pixels; a hand at least 24)"), std::string::npos) << r.reason;
+  EXPECT_FALSE(r.searched);
   // A shape no database view resembles is not a hand.
   options.max_distance = 0.05;
   options.max_elongation = 100.0;  // the bar below is thin too; here its distance is tested
@@ -604,6 +613,9 @@ TEST_F(EstimatorTest, BadSetUpsAreRefused) {
   EstimatorOptions options = Options();
   options.k = 0;
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "k must be");
+  options = Options();
+  options.min_hand_px = 0;
+  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "smallest hand");
   testing::ExpectError([&] { Estimator(*db_, *index_, testing::LeftHand(), Options()); }, "right hand model");
   // An index of another descriptor.
   IndexedSet other = DatabaseDescriptors(*db_);

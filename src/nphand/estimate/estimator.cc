@@ -160,6 +160,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the hand length must be within [0.05, 0.4] metres";
   } else if (!(max_elongation >= 1.0)) {
     *why = "the largest elongation must be at least 1 (a disk)";
+  } else if (min_hand_px < 1) {
+    *why = "the smallest hand must span at least 1 pixel";
   } else if (!(hand_memory >= 0.0 && hand_memory < 1.0) || !(hand_switch >= 0.0 && hand_switch < 10.0)) {
     *why = "the side's memory must be within [0, 1) and its switching margin within [0, 10)";
   } else if (learn_interval < 1) {
@@ -392,7 +394,12 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {
   result.time_s = time_s;
   const SkinSegmentation skin = segmenter_.Segment(bgr);
   std::vector<const SkinRegion*> candidates;
-  for (const SkinRegion& r : skin.regions) candidates.push_back(&r);
+  int widest = 0;
+  for (const SkinRegion& r : skin.regions) {
+    const int across = std::max(r.box.width, r.box.height);
+    widest = std::max(widest, across);
+    if (across >= options_.min_hand_px) candidates.push_back(&r);
+  }
   // Larger and nearer the last hand first.
   const double spread = 0.2 * std::hypot(bgr.cols, bgr.rows);
   auto score = [&](const SkinRegion* r) {
@@ -408,7 +415,9 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {
   result.ms.segment = Ms(start, Clock::now());
   if (candidates.empty()) {
     result.status = FrameStatus::kNoSkin;
-    result.reason = skin.colourless         ? "the frame has no colour (greyscale): skin cannot be told by its colour"
+    result.reason = widest > 0 ? "no skin-coloured region of a hand's size (the largest spans " + std::to_string(widest) +
+                                     " pixels; a hand at least " + std::to_string(options_.min_hand_px) + ")"
+                    : skin.colourless      ? "the frame has no colour (greyscale): skin cannot be told by its colour"
                     : skin.body_pixels > 0 ? "only faces and the bodies below them are skin-coloured"
                     : skin.face_pixels > 0 ? "only faces are skin-coloured"
                                            : "no skin-coloured region";

@@ -68,6 +68,10 @@ struct EstimatorOptions {
   // of skin (a neck's edge beside a face) is no hand. The default database's silhouettes:
   // 99.9 % at most 4.7, 99.99 % at most 5.9, the thinnest 10.0 (`nphand db info`).
   double max_elongation = 6.0;
+  // No hand in a skin region whose box spans fewer frame pixels than this on its longer
+  // side: the descriptor's 8 x 8 cells would each hold under 3 of its pixels. Such specks
+  // are not looked up, so a frame holding only them is "no skin of a hand's size".
+  int min_hand_px = 24;
   Handedness hand = Handedness::kRight;         // left: mirrored into the right-hand database
   // Either side (`--hand auto`): each region is searched as it is and mirrored, and the side
   // whose nearest entry is nearer gains the difference of the two distances as evidence.
