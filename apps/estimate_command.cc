@@ -17,6 +17,7 @@
 #include "nphand/motion/bvh.h"
 #include "nphand/motion/gltf_motion.h"
 #include "nphand/motion/motion.h"
+#include "nphand/refine/refiner.h"
 #include "nphand/render/draw.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
@@ -139,6 +140,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   SetHandChoice(options.hand, &estimator_options);
   estimator_options.observation = ObservationWeightFromString(options.observation);
   estimator_options.prior = PriorCombinationFromString(options.prior);
+  SetRefineMoves(options.refine_move, &estimator_options.refinement);
   if (!options.faces) estimator_options.skin.face_cascade.clear();
   std::string why;
   NPHAND_THROW_CHECK(estimator_options.Check(&why), "estimate: ", why);

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -25,6 +26,7 @@ struct EstimateCommandOptions : EstimatorFiles {
   std::string hand = "right";
   std::string observation = "fixed";
   std::string prior = "product";
+  std::vector<std::string> refine_move = {"place", "wrist"};  // what the refinement moves (SetRefineMoves)
   double fps = 30.0;                      // for image folders
   uint64_t max_frames = 0;                // 0: all
   bool top = false;                       // write the top-N hypotheses

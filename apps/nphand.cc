@@ -187,6 +187,9 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_flag("--refine,!--no-refine", e.refine, "Refine the best view's pose until its silhouette agrees with the hand's");
   cmd->add_option("--refine-sweeps", e.refinement.sweeps, "Refinement: passes over the wrist's and fingers' directions")
       ->capture_default_str();
+  cmd->add_option("--refine-move", o.refine_move, "Refinement: what moves, any of place, wrist and fingers")
+      ->delimiter(',')
+      ->capture_default_str();
   cmd->add_flag("--smooth,!--no-smooth", e.smooth, "Smooth the track's poses over time (a One Euro filter)")->capture_default_str();
   cmd->add_option("--smooth-cutoff", e.smoothing.min_cutoff_hz, "Smoothing: the cutoff of a still hand, Hz")->capture_default_str();
   cmd->add_option("--smooth-beta", e.smoothing.beta, "Smoothing: the cutoff's rise with the hand's speed")->capture_default_str();

@@ -104,6 +104,23 @@ TEST_F(EstimateCommandTest, AFolderGivesOneLinePerFrameWithEveryFieldAndAnOverla
   options.hand = "ambidextrous";
   testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "choose right, left or auto");
   options.hand = "right";
+  // What the refinement moves: the default keeps the lookup's joints, fingers moves them.
+  options.estimator.refine = true;
+  RunEstimate(options, nullptr, nullptr);
+  const std::vector<nlohmann::json> placed = Lines(options.out);
+  options.refine_move = {"place", "wrist", "fingers"};
+  RunEstimate(options, nullptr, nullptr);
+  const std::vector<nlohmann::json> fingers = Lines(options.out);
+  ASSERT_EQ(placed.size(), fingers.size());
+  int joints_moved = 0;
+  for (size_t i = 0; i < placed.size(); ++i) {
+    if (placed[i]["detected"].get<bool>()) joints_moved += placed[i]["joint_angles_deg"] != fingers[i]["joint_angles_deg"];
+  }
+  EXPECT_GE(joints_moved, 1);
+  options.refine_move = {"place", "knuckles"};
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "unknown refinement move 'knuckles'");
+  options.refine_move = {"place", "wrist"};
+  options.estimator.refine = false;
   RunEstimate(options, nullptr, nullptr);
   // And the errors against the truth.
   EvalPosesCommandOptions eval;

@@ -171,6 +171,25 @@ TEST(RefinerTest, EmptyAndWrongTargetsAndOptions) {
   testing::ExpectError([&] { Refiner(RightHand(), Camera(), 0.0, Crop()); }, "distance must be positive");
 }
 
+TEST(RefinerTest, WhatMovesIsChosenByName) {
+  RefineOptions options;
+  EXPECT_EQ(RefineMoves(options), (std::vector<std::string>{"place", "wrist"}));
+  SetRefineMoves({"fingers", "wrist"}, &options);
+  EXPECT_FALSE(options.move_place);
+  EXPECT_TRUE(options.move_wrist);
+  EXPECT_TRUE(options.move_fingers);
+  EXPECT_EQ(RefineMoves(options), (std::vector<std::string>{"wrist", "fingers"}));
+  const RefineOptions kept = options;
+  testing::ExpectError([&] { SetRefineMoves({"place", "thumb"}, &options); }, "unknown refinement move 'thumb'");
+  testing::ExpectError([&] { SetRefineMoves({"wrist", "wrist"}, &options); }, "'wrist' is named twice");
+  testing::ExpectError([&] { SetRefineMoves({}, &options); }, "must move something");
+  EXPECT_EQ(RefineMoves(options), RefineMoves(kept));  // a refused list changes nothing
+  options.move_wrist = options.move_fingers = false;
+  std::string why;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("must move something"), std::string::npos) << why;
+}
+
 TEST(RefinerTest, DisagreementIsOneMinusIoUAndSkipsTheUnknown) {
   cv::Mat a = cv::Mat::zeros(8, 8, CV_32FC1), b = cv::Mat::zeros(8, 8, CV_32FC1);
   a(cv::Rect(0, 0, 4, 8)).setTo(1.0);

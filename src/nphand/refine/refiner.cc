@@ -82,12 +82,38 @@ bool RefineOptions::Check(std::string* why) const {
     *why = "the refinement's track bound must be within [0, 180] degrees";
   } else if (!(blur_px >= 0.0 && blur_px <= 8.0)) {
     *why = "the refinement's blur must be within [0, 8] crop pixels";
+  } else if (!move_place && !move_wrist && !move_fingers) {
+    *why = "the refinement must move something: the place, the wrist or the fingers";
   } else if (render_side < 16 || render_side > 1024) {
     *why = "the refinement's render side must be within 16..1024 pixels";
   } else {
     return true;
   }
   return false;
+}
+
+void SetRefineMoves(const std::vector<std::string>& names, RefineOptions* options) {
+  NPHAND_THROW_CHECK(!names.empty(), "the refinement must move something: name any of place, wrist and fingers");
+  RefineOptions moves = *options;
+  moves.move_place = moves.move_wrist = moves.move_fingers = false;
+  for (const std::string& name : names) {
+    bool* move = name == "place"     ? &moves.move_place
+                 : name == "wrist"   ? &moves.move_wrist
+                 : name == "fingers" ? &moves.move_fingers
+                                     : nullptr;
+    NPHAND_THROW_CHECK(move != nullptr, "unknown refinement move '", name, "' (choose any of place, wrist and fingers)");
+    NPHAND_THROW_CHECK(!*move, "the refinement move '", name, "' is named twice");
+    *move = true;
+  }
+  *options = moves;
+}
+
+std::vector<std::string> RefineMoves(const RefineOptions& options) {
+  std::vector<std::string> names;
+  if (options.move_place) names.push_back("place");
+  if (options.move_wrist) names.push_back("wrist");
+  if (options.move_fingers) names.push_back("fingers");
+  return names;
 }
 
 nlohmann::json ToJson(const RefineOptions& options) {

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -49,6 +50,12 @@ struct RefineOptions {
 };
 
 nlohmann::json ToJson(const RefineOptions& options);
+
+// What the search moves, by name: any of "place", "wrist" and "fingers" (`--refine-move`;
+// the default is place and wrist). Throws nphand::Error naming an unknown or repeated name,
+// or for none.
+void SetRefineMoves(const std::vector<std::string>& names, RefineOptions* options);
+std::vector<std::string> RefineMoves(const RefineOptions& options);
 
 // A silhouette agreement of two crop coverages (CV_32FC1 of one size): 1 - the
 // intersection over union (sum of minima over sum of maxima), in [0, 1] (0: the same).
