@@ -70,7 +70,8 @@ struct EstimatorOptions {
   double max_elongation = 6.0;
   // No hand in a skin region whose box spans fewer frame pixels than this on its longer
   // side: the descriptor's 8 x 8 cells would each hold under 3 of its pixels. Such specks
-  // are not looked up, so a frame holding only them is "no skin of a hand's size".
+  // are not looked up: a frame holding only them is no_skin ("no skin-coloured region of a
+  // hand's size").
   int min_hand_px = 24;
   Handedness hand = Handedness::kRight;         // left: mirrored into the right-hand database
   // Either side (`--hand auto`): each region is searched as it is and mirrored, and the side
