@@ -126,6 +126,9 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   EstimatorOptions estimator_options;
   if (!options.faces) estimator_options.skin.face_cascade.clear();
   estimator_options.refine = options.refine;
+  estimator_options.max_distance = options.max_distance;
+  std::string why;
+  NPHAND_THROW_CHECK(estimator_options.Check(&why), "eval real: ", why);
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, index, hand, estimator_options);
@@ -143,6 +146,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["index"] = index.Backend();
   result.figures["hand"] = options.hand;
   result.figures["refine"] = options.refine;
+  result.figures["max_distance"] = options.max_distance;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {
     std::string lines;

@@ -82,6 +82,7 @@ struct EvalRealCommandOptions : EstimatorFiles {
   bool faces = true;              // set faces aside (OpenCV's cascade)
   std::string hand = "given";     // "given": the labelled side; "auto": the estimator chooses
   bool refine = false;            // the estimator refines its best view (refine/refiner.h)
+  double max_distance = EstimatorOptions{}.max_distance;  // "no hand" beyond this feature distance
 };
 
 struct EvalRealResult {

@@ -316,6 +316,16 @@ TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles
   refined.refine = true;
   refined.out_dir.clear();
   EXPECT_EQ(RunEvalReal(refined, nullptr).figures["refine"], true);
+  // --max-distance: so strict that no view is near enough, every hand is missed.
+  EvalRealCommandOptions strict = refined;
+  strict.refine = false;
+  strict.max_distance = 0.01;
+  const EvalRealResult none = RunEvalReal(strict, nullptr);
+  EXPECT_EQ(none.figures["max_distance"], 0.01);
+  EXPECT_EQ(none.figures["per_source"]["asl_video"]["found"], 0);
+  EXPECT_EQ(none.figures["per_source"]["freihand"]["found"], 0);
+  strict.max_distance = 0.0;
+  testing::ExpectError([&] { RunEvalReal(strict, nullptr); }, "largest distance");
   chosen.hand = "both";
   testing::ExpectError([&] { RunEvalReal(chosen, nullptr); }, "--hand is given or auto");
   // A label naming a missing image is refused by name before any work; so is an output

@@ -47,6 +47,7 @@ TEST_F(EstimatorStudyTest, EverySettingIsNamedOnceAndVariesWhatItSays) {
   EXPECT_EQ(find("refine-fingers4").options.refinement.joint_step_deg, 4.0);
   EXPECT_FALSE(find("refine-place").options.refinement.move_wrist);
   EXPECT_EQ(find("refine-render128-sweeps6").options.refinement.render_side, 128);
+  EXPECT_EQ(find("max-distance0.9").options.max_distance, 0.9);
 }
 
 // On the rendered masks (the paper's input) hands are found, and refinement is reported as

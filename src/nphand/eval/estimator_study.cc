@@ -70,6 +70,12 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     name << "arm-length" << length;
     around_default(name.str(), [&](EstimatorOptions& e) { e.forearm.min_arm_length = length; });
   }
+  // How far the nearest view may lie before a region is "no hand".
+  for (double distance : {0.85, 0.9}) {
+    std::ostringstream name;
+    name << "max-distance" << distance;
+    around_default(name.str(), [&](EstimatorOptions& e) { e.max_distance = distance; });
+  }
   // Refinement beyond the database (refine/refiner.h): its default (the place and the
   // wrist, pulled towards the last frame's), the place alone, with the fingers too (in two
   // step sizes), other pulls, finer renders and more passes.
