@@ -17,7 +17,6 @@
 #include "nphand/motion/bvh.h"
 #include "nphand/motion/gltf_motion.h"
 #include "nphand/motion/motion.h"
-#include "nphand/refine/refiner.h"
 #include "nphand/render/draw.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"

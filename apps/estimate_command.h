@@ -14,6 +14,7 @@
 #include "apps/estimator_files.h"
 #include "nphand/estimate/estimator.h"
 #include "nphand/model/hand_model.h"
+#include "nphand/refine/refiner.h"
 
 namespace nphand {
 
@@ -26,7 +27,7 @@ struct EstimateCommandOptions : EstimatorFiles {
   std::string hand = "right";
   std::string observation = "fixed";
   std::string prior = "product";
-  std::vector<std::string> refine_move = {"place", "wrist"};  // what the refinement moves (SetRefineMoves)
+  std::vector<std::string> refine_move = RefineMoves(RefineOptions{});  // what the refinement moves (SetRefineMoves)
   double fps = 30.0;                      // for image folders
   uint64_t max_frames = 0;                // 0: all
   bool top = false;                       // write the top-N hypotheses

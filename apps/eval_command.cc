@@ -127,8 +127,6 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   if (!options.faces) estimator_options.skin.face_cascade.clear();
   estimator_options.refine = options.refine;
   estimator_options.max_distance = options.max_distance;
-  std::string why;
-  NPHAND_THROW_CHECK(estimator_options.Check(&why), "eval real: ", why);
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, index, hand, estimator_options);
