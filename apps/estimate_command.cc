@@ -143,6 +143,10 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
   if (!options.faces) estimator_options.skin.face_cascade.clear();
   std::string why;
   NPHAND_THROW_CHECK(estimator_options.Check(&why), "estimate: ", why);
+  NPHAND_THROW_CHECK(options.roi.empty() || (options.roi.size() == 4 && options.roi[2] > 0 && options.roi[3] > 0),
+                     "estimate: --roi is x,y,width,height in pixels, with a width and height above 0");
+  std::optional<cv::Rect> roi;
+  if (!options.roi.empty()) roi = cv::Rect(options.roi[0], options.roi[1], options.roi[2], options.roi[3]);
   CheckOutputFile(options.out, "--out");
   if (!options.overlay.empty()) CheckOutputFile(options.overlay, "--overlay");
   if (!options.bvh.empty()) CheckOutputFile(options.bvh, "--bvh");
@@ -205,7 +209,7 @@ nlohmann::json RunEstimate(const EstimateCommandOptions& options, std::ostream* 
           unreadable_reasons.push_back(frame->error);
         }
       } else {
-        const FrameResult result = estimator.Process(frame->bgr, frame->time_s);
+        const FrameResult result = estimator.Process(frame->bgr, frame->time_s, roi);
         json = FrameResultJson(result, db, options.top);
         json["frame"] = frames;  // the input's numbering, unreadable frames included
         detected += result.detected();

@@ -32,6 +32,7 @@ struct EstimateCommandOptions : EstimatorFiles {
   uint64_t max_frames = 0;                // 0: all
   bool top = false;                       // write the top-N hypotheses
   bool faces = true;                      // set faces aside (OpenCV's cascade from opencv-data)
+  std::vector<int> roi;                   // x, y, width, height: the hand sought there only (empty: everywhere)
   EstimatorOptions estimator;
 };
 

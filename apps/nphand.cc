@@ -184,6 +184,9 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--hand-length", e.hand_length_m, "Wrist to middle fingertip, metres")->capture_default_str();
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
   cmd->add_flag("!--no-forearm-cut", e.cut_forearm, "Do not cut the forearm at the wrist");
+  cmd->add_option("--roi", o.roi, "x,y,width,height: seek the hand in this part of the frame only (skin elsewhere is ignored)")
+      ->delimiter(',')
+      ->expected(4);
   cmd->add_flag("--refine,!--no-refine", e.refine, "Refine the best view's pose until its silhouette agrees with the hand's");
   cmd->add_option("--refine-sweeps", e.refinement.sweeps, "Refinement: passes over the wrist's and fingers' directions")
       ->capture_default_str();

@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <array>
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -130,13 +131,19 @@ class Estimate {
       : db_(std::move(db)), index_(std::move(index)), hand_(std::move(hand)),
         estimator_(std::make_unique<Estimator>(*db_, *index_, *hand_, options)) {}
 
-  FrameResult Process(const BgrArray& frame, std::optional<double> time_s) {
+  FrameResult Process(const BgrArray& frame, std::optional<double> time_s, std::optional<std::array<int, 4>> roi) {
     const cv::Mat bgr = FrameMat(frame);
     const double t = time_s.value_or(next_time_);
+    std::optional<cv::Rect> box;
+    if (roi.has_value()) {
+      const auto [x, y, width, height] = *roi;
+      NPHAND_THROW_CHECK(width > 0 && height > 0, "estimator: roi is (x, y, width, height) in pixels, with a width and height above 0");
+      box = cv::Rect(x, y, width, height);
+    }
     FrameResult result;
     {
       py::gil_scoped_release release;
-      result = estimator_->Process(bgr, t);
+      result = estimator_->Process(bgr, t, box);
     }
     next_time_ = t + 1.0 / 30.0;
     return result;
@@ -338,8 +345,9 @@ PYBIND11_MODULE(nphand, m) {
            py::arg("db"), py::arg("index"), py::arg("hand_model"), py::arg("hand") = "right", py::arg("k") = 500,
            py::arg("refine") = false, py::arg("smooth") = true, py::arg("hand_length") = 0.18, py::arg("fov") = 60.0,
            py::arg("focal") = 0.0, py::arg("faces") = true)
-      .def("process", &Estimate::Process, py::arg("frame"), py::arg("time_s") = py::none(),
-           "Estimates the hand in the next frame (H x W x 3 uint8 BGR); time_s defaults to 1/30 s after the last")
+      .def("process", &Estimate::Process, py::arg("frame"), py::arg("time_s") = py::none(), py::arg("roi") = py::none(),
+           "Estimates the hand in the next frame (H x W x 3 uint8 BGR); time_s defaults to 1/30 s after the last; "
+           "roi (x, y, width, height), e.g. from your own hand detector, confines the search to that box")
       .def("reset", &Estimate::Reset, "Forgets the track (a new video)");
 
   m.def("draw", &Drawn, py::arg("frame"), py::arg("keypoints_2d"),

@@ -100,6 +100,24 @@ def test_bad_frames_are_refused(hand, tiny):
         nphand.Estimator(db, index, hand, k=0)
     # A frame with nothing in it is "no hand", not an error.
     assert not estimator.process(np.zeros((48, 64, 3), np.uint8)).detected
+    with pytest.raises(nphand.Error, match="width and height above 0"):
+        estimator.process(np.zeros((48, 64, 3), np.uint8), roi=(0, 0, 0, 5))
+    with pytest.raises(nphand.Error, match="does not meet the 64 x 48 frame"):
+        estimator.process(np.zeros((48, 64, 3), np.uint8), roi=(70, 0, 5, 5))
+
+
+def test_a_region_of_interest_confines_the_search(hand, tiny, frames):
+    db, index = tiny
+    estimator = nphand.Estimator(db, index, hand, k=40, faces=False, smooth=False)
+    frame = frames[0]["rgb"]
+    whole = estimator.process(frame)
+    assert whole.detected, whole.reason
+    x, y, w, h = whole.box
+    estimator.reset()
+    assert estimator.process(frame, roi=(x - 5, y - 5, w + 10, h + 10)).box == whole.box
+    estimator.reset()
+    corner = estimator.process(frame, roi=(0, 0, 4, 4))
+    assert not corner.detected and corner.reason == "no skin-coloured region within the region of interest"
 
 
 def test_two_threads_each_drive_their_own_estimator(hand, tiny, frames):

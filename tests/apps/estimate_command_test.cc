@@ -131,6 +131,29 @@ TEST_F(EstimateCommandTest, AFolderGivesOneLinePerFrameWithEveryFieldAndAnOverla
   EXPECT_EQ(errors.frames.size(), 5u);
   EXPECT_EQ(errors.detected, detected);
   EXPECT_TRUE(std::filesystem::exists(*dir_ / "errors" / "errors.png"));
+  // --roi: a box over the whole frame changes nothing; one on a corner without skin finds
+  // no hand, and says why; a box that is no box is refused.
+  auto untimed = [&] {
+    std::vector<nlohmann::json> lines = Lines(options.out);
+    for (nlohmann::json& line : lines) line.erase("ms");
+    return lines;
+  };
+  const std::vector<nlohmann::json> everywhere = untimed();
+  options.roi = {-10, -10, 400, 400};
+  RunEstimate(options, nullptr, nullptr);
+  EXPECT_EQ(untimed(), everywhere);
+  options.roi = {0, 0, 6, 6};
+  RunEstimate(options, nullptr, nullptr);
+  for (const nlohmann::json& line : Lines(options.out)) {
+    EXPECT_EQ(line["reason"], "no skin-coloured region within the region of interest") << line.dump();
+  }
+  options.roi = {0, 0, 0, 10};
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "--roi is x,y,width,height");
+  // A box off the frame is refused at the first frame, and the last output stays whole.
+  const std::vector<nlohmann::json> corner = untimed();
+  options.roi = {1000, 0, 10, 10};
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "does not meet the 240 x 180 frame");
+  EXPECT_EQ(untimed(), corner);
 }
 
 TEST_F(EstimateCommandTest, AStopLeavesCompleteLinesAndMaxFramesStops) {

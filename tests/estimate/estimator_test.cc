@@ -609,6 +609,42 @@ TEST_F(EstimatorTest, SmoothingSteadiesTheKeypointsAndKeepsThemAHand) {
   }
 }
 
+// A region of interest (a box from the caller's own detector or tracker) confines the
+// search: skin outside it is no candidate, skin crossing it is clipped to it (its edges
+// count as the frame's for the forearm cut), and a box off the frame is refused.
+TEST_F(EstimatorTest, ARegionOfInterestConfinesTheSearch) {
+  Estimator estimator(*db_, *index_, RightHand(), Options());
+  SequenceOptions settings = SmallSequence(1);
+  settings.width = 640;
+  settings.distance_m = 0.6;
+  const SequenceFrame frame = Sequence(RightHand(), settings).Render(0);
+  const cv::Rect hand = cv::boundingRect(frame.labels == static_cast<int>(PixelLabel::kHand));
+  // A skin-coloured board to the left of the hand, which reaches the hand's region from
+  // the frame's left, and the arm from the hand to the top right.
+  cv::Mat bgr = frame.rgb.clone();
+  const cv::Rect board(4, 20, hand.x - 40, 200);
+  ASSERT_GT(board.width, 100);
+  cv::rectangle(bgr, board, SkinToneByName("olive").bgr, cv::FILLED);
+  const cv::Rect around(hand.x - 20, hand.y - 20, hand.width + 40, hand.height + 40);
+  FrameResult r = estimator.Process(bgr, 0.0, around);
+  ASSERT_TRUE(r.detected()) << r.reason;
+  EXPECT_EQ(r.box & around, r.box);
+  EXPECT_GT((r.box & hand).area(), 0.8 * hand.area());
+  EXPECT_TRUE(r.forearm_cut) << "the arm leaves the region of interest at its edge";
+  // The board alone is no hand.
+  estimator.Reset();
+  r = estimator.Process(bgr, 0.0, board + cv::Size(8, 0));
+  EXPECT_EQ(r.status, FrameStatus::kNotAHand) << r.reason;
+  // Above the hand, within the bounds of the arm's region but on none of its pixels.
+  const cv::Rect above(board.br().x + 10, 0, 120, 40);
+  ASSERT_EQ(cv::countNonZero(frame.labels(above) == static_cast<int>(PixelLabel::kForearm)), 0);
+  estimator.Reset();
+  r = estimator.Process(bgr, 0.0, above);
+  EXPECT_EQ(r.status, FrameStatus::kNoSkin);
+  EXPECT_EQ(r.reason, "no skin-coloured region within the region of interest");
+  testing::ExpectError([&] { estimator.Process(bgr, 0.0, cv::Rect(700, 0, 50, 50)); }, "does not meet the 640 x 240 frame");
+}
+
 TEST_F(EstimatorTest, BadSetUpsAreRefused) {
   EstimatorOptions options = Options();
   options.k = 0;

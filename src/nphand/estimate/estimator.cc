@@ -27,14 +27,16 @@ double Ms(Clock::time_point from, Clock::time_point to) {
 // A hand region together with the pieces an object splits off it (skin regions whose boxes
 // meet the region's box grown by 30 % of its longer side): their pixels within `*box`, which
 // gets the pixels' bounds.
-cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, cv::Rect* box) {
-  const cv::Rect reach = HandReach(seed.box);
+// Only pixels within `view` count (the frame, or the caller's region of interest); an
+// empty mask (and box) when the seed has none there.
+cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, const cv::Rect& view, cv::Rect* box) {
+  const cv::Rect reach = HandReach(seed.box & view);
   std::vector<int> labels = {seed.label};
-  cv::Rect bounds = seed.box;
+  cv::Rect bounds = seed.box & view;
   for (const SkinRegion& r : s.regions) {
-    if (r.label == seed.label || (r.box & reach).area() == 0) continue;
+    if (r.label == seed.label || (r.box & view & reach).area() == 0) continue;
     labels.push_back(r.label);
-    bounds |= r.box;
+    bounds |= r.box & view;
   }
   const cv::Mat mask = s.Mask(labels, bounds);
   const cv::Rect tight = cv::boundingRect(mask);
@@ -42,9 +44,11 @@ cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, cv::Rect* 
   return mask(tight);
 }
 
-int Border(const cv::Rect& box, const cv::Size& frame) {
-  return (box.x == 0 ? 1 : 0) | (box.y == 0 ? 2 : 0) | (box.x + box.width == frame.width ? 4 : 0) |
-         (box.y + box.height == frame.height ? 8 : 0);
+// Which sides of `box` lie on the edges of `view` (the frame, or the caller's region of
+// interest): bit 0 left, 1 top, 2 right, 3 bottom (see CutForearm).
+int Border(const cv::Rect& box, const cv::Rect& view) {
+  return (box.x == view.x ? 1 : 0) | (box.y == view.y ? 2 : 0) | (box.x + box.width == view.x + view.width ? 4 : 0) |
+         (box.y + box.height == view.y + view.height ? 8 : 0);
 }
 
 Eigen::Vector2d Apply(const cv::Matx23d& a, const Eigen::Vector2d& p) {
@@ -336,8 +340,8 @@ RenderedImages Estimator::RenderEntry(uint32_t entry) {
   return renderer_.Render(EntryScene(entry), db_intrinsics_, options);
 }
 
-FrameResult Estimator::Process(const cv::Mat& bgr, double time_s) {
-  FrameResult result = Detect(bgr, time_s);
+FrameResult Estimator::Process(const cv::Mat& bgr, double time_s, const std::optional<cv::Rect>& roi) {
+  FrameResult result = Detect(bgr, time_s, roi);
   Smooth(&result);
   return result;
 }
@@ -387,8 +391,12 @@ void Estimator::Smooth(FrameResult* r) {
   r->depth_m = wrist[3];
 }
 
-FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {
+FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::optional<cv::Rect>& roi) {
   const Clock::time_point start = Clock::now();
+  const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect view = roi.has_value() ? *roi & frame : frame;
+  NPHAND_THROW_CHECK(!roi.has_value() || view.area() > 0, "estimator: the region of interest (", roi->x, ", ", roi->y, ", ",
+                     roi->width, " x ", roi->height, ") does not meet the ", bgr.cols, " x ", bgr.rows, " frame");
   FrameResult result;
   result.frame = frame_++;
   result.time_s = time_s;
@@ -396,7 +404,9 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {
   std::vector<const SkinRegion*> candidates;
   int widest = 0;
   for (const SkinRegion& r : skin.regions) {
-    const int across = std::max(r.box.width, r.box.height);
+    const cv::Rect within = r.box & view;
+    if (within.area() == 0 || (within != r.box && cv::countNonZero(skin.Mask({r.label}, within)) == 0)) continue;
+    const int across = std::max(within.width, within.height);
     widest = std::max(widest, across);
     if (across >= options_.min_hand_px) candidates.push_back(&r);
   }
@@ -417,6 +427,7 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {
     result.status = FrameStatus::kNoSkin;
     result.reason = widest > 0 ? "no skin-coloured region of a hand's size (the largest spans " + std::to_string(widest) +
                                      " pixels; a hand at least " + std::to_string(options_.min_hand_px) + ")"
+                    : roi.has_value() && !skin.regions.empty() ? "no skin-coloured region within the region of interest"
                     : skin.colourless      ? "the frame has no colour (greyscale): skin cannot be told by its colour"
                     : skin.body_pixels > 0 ? "only faces and the bodies below them are skin-coloured"
                     : skin.face_pixels > 0 ? "only faces are skin-coloured"
@@ -429,12 +440,12 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s) {
   for (size_t c = 0; c < std::min<size_t>(2, candidates.size()); ++c) {
     const Clock::time_point part = Clock::now();
     cv::Rect region_box;
-    const cv::Mat region = GatherHand(skin, *candidates[c], &region_box);
+    const cv::Mat region = GatherHand(skin, *candidates[c], view, &region_box);
     cv::Mat hand = cv::Mat::zeros(bgr.size(), CV_8UC1);
     cv::Rect box = region_box;
     bool cut = false;
     if (options_.cut_forearm) {
-      const ForearmCut forearm = CutForearm(region, Border(region_box, bgr.size()), options_.forearm);
+      const ForearmCut forearm = CutForearm(region, Border(region_box, view), options_.forearm);
       cut = forearm.cut;
       forearm.hand.copyTo(hand(region_box));
       if (cut) box = cv::boundingRect(forearm.hand) + region_box.tl();

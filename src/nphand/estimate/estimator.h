@@ -197,8 +197,12 @@ class Estimator {
   // a hand model of another asset, or a database of the other hand.
   Estimator(const Database& db, const KnnIndex& index, const HandModel& hand, const EstimatorOptions& options);
 
-  // The next frame (8-bit BGR) of a video at `time_s`.
-  FrameResult Process(const cv::Mat& bgr, double time_s);
+  // The next frame (8-bit BGR) of a video at `time_s`. With `roi` (frame pixels: a box from
+  // the caller's own detector or tracker, or a fixed workspace) the hand is sought there
+  // only: skin regions that do not meet it are no candidates, the others are clipped to it,
+  // and its edges count as the frame's (an arm clipped there enters from an edge). Throws
+  // nphand::Error for a box that does not meet the frame.
+  FrameResult Process(const cv::Mat& bgr, double time_s, const std::optional<cv::Rect>& roi = std::nullopt);
   // The same from a hand mask (CV_8UC1, non-zero = hand) instead of a frame: no
   // segmentation, no region choice, no forearm cut.
   FrameResult ProcessMask(const cv::Mat& mask, double time_s);
@@ -212,7 +216,7 @@ class Estimator {
 
  private:
   // Process and ProcessMask before smoothing.
-  FrameResult Detect(const cv::Mat& bgr, double time_s);
+  FrameResult Detect(const cv::Mat& bgr, double time_s, const std::optional<cv::Rect>& roi);
   FrameResult DetectMask(const cv::Mat& mask, double time_s);
   // With smooth: `r` filtered with the track's last estimates: the joint angles, the
   // rotation, the wrist's place and the image keypoints, the 3D keypoints then made from
