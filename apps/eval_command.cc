@@ -136,7 +136,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
     estimator_options.hand = Handedness::kLeft;
     left.emplace(db, index, hand, estimator_options);
   }
-  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, left ? &*left : nullptr, progress);
+  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, left ? &*left : nullptr, options.given_box, progress);
   const RealScore score = ScoreReal(labels, predictions);
   EvalRealResult result{ToJson(score), FormatTable(score)};
   result.figures["labels"] = options.labels.string();
@@ -145,6 +145,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["hand"] = options.hand;
   result.figures["refine"] = options.refine;
   result.figures["max_distance"] = options.max_distance;
+  result.figures["given_box"] = options.given_box;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {
     std::string lines;

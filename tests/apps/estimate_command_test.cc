@@ -339,6 +339,12 @@ TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles
   refined.refine = true;
   refined.out_dir.clear();
   EXPECT_EQ(RunEvalReal(refined, nullptr).figures["refine"], true);
+  // --given-box: each labelled hand estimated within its found region.
+  EvalRealCommandOptions boxed = options;
+  boxed.given_box = true;
+  boxed.out_dir.clear();
+  const EvalRealResult given = RunEvalReal(boxed, nullptr);
+  EXPECT_EQ(given.figures["given_box"], true);
   // --max-distance: so strict that no view is near enough, every hand is missed.
   EvalRealCommandOptions strict = refined;
   strict.refine = false;

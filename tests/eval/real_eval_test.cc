@@ -9,11 +9,16 @@
 #include <string>
 #include <vector>
 
+#include <fstream>
+
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "nphand/db/builder.h"
 #include "nphand/index/backends.h"
+#include "nphand/sequence/sequence.h"
 #include "testing/testing.h"
+#include "testing/tiny_db.h"
 
 namespace nphand {
 namespace {
@@ -48,8 +53,57 @@ TEST(RealEvalTest, TheHandIsFoundOnRealPhotographs) {
   options.hand = Handedness::kLeft;
   Estimator left(db, *index, testing::RightHand(), options);
 
-  const RealScore score = ScoreReal(labels, EstimateReal(labels, dev, &right, &left, nullptr));
+  const RealScore score = ScoreReal(labels, EstimateReal(labels, dev, &right, &left, false, nullptr));
   for (const RealHandScore& hand : score.hands) EXPECT_TRUE(hand.found) << hand.label->file;
+}
+
+// With the box given, each labelled hand of a still is estimated alone, within its region:
+// two hands side by side give two estimates, each on its own hand; without it, one search
+// a labelled side finds one of them.
+TEST(RealEvalTest, WithTheBoxGivenEachLabelledHandIsEstimatedInItsRegion) {
+  const auto dir = testing::ScratchDir();
+  const Database db = Database::Open(testing::BuildTinyDatabase(dir / "tiny.db"));
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db, IndexOptions::Exact());
+  EstimatorOptions options;
+  options.skin.face_cascade.clear();
+  options.max_distance = 2.0;  // the tiny database's views are far apart
+  Estimator right(db, *index, testing::RightHand(), options);
+  options.hand = Handedness::kLeft;
+  Estimator left(db, *index, testing::RightHand(), options);
+
+  SequenceOptions settings;
+  settings.frames = 1;
+  settings.grasp = 1;
+  settings.width = 240;
+  settings.height = 180;
+  settings.distance_m = 0.4;
+  settings.seed = testing::kTestSeed;
+  const SequenceFrame frame = Sequence(testing::RightHand(), settings).Render(0);
+  cv::Mat two;
+  cv::hconcat(frame.rgb, frame.rgb, two);
+  std::filesystem::create_directories(dir / "images");
+  ASSERT_TRUE(cv::imwrite((dir / "images" / "two.png").string(), two));
+  {
+    std::ofstream out(dir / "labels.jsonl");
+    for (double shift : {0.0, 240.0}) {
+      nlohmann::json keypoints = nlohmann::json::array();
+      for (const Eigen::Vector2d& k : frame.keypoints_2d) keypoints.push_back({k.x() + shift, k.y()});
+      out << nlohmann::json({{"file", "images/two.png"}, {"hand", "right"}, {"keypoints_2d_px", keypoints}}).dump() << "\n";
+    }
+  }
+  const std::vector<RealLabel> labels = ReadRealLabels(dir / "labels.jsonl");
+  const std::vector<RealPrediction> one = EstimateReal(labels, dir, &right, &left, false, nullptr);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_LE(one[0].hands.size(), 1u);
+  const std::vector<RealPrediction> given = EstimateReal(labels, dir, &right, &left, true, nullptr);
+  ASSERT_EQ(given.size(), 1u);
+  ASSERT_EQ(given[0].hands.size(), 2u);
+  for (int h = 0; h < 2; ++h) {
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& k : given[0].hands[h].keypoints_2d) centre += k / kNumKeypoints;
+    EXPECT_GE(centre.x(), labels[h].region[0]) << h;
+    EXPECT_LE(centre.x(), labels[h].region[2]) << h;
+  }
 }
 
 }  // namespace

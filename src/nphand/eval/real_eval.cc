@@ -1,7 +1,9 @@
 #include "nphand/eval/real_eval.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <opencv2/imgcodecs.hpp>
@@ -72,17 +74,31 @@ void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem:
 }
 
 std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, const std::filesystem::path& root,
-                                         Estimator* right, Estimator* left, std::ostream* progress) {
-  // Images and videos in the order of their first label; the sides labelled in each.
+                                         Estimator* right, Estimator* left, bool given_box, std::ostream* progress) {
+  // Images and videos in the order of their first label; the sides labelled in each, and
+  // the labels of each still and of each video frame.
   std::vector<std::string> stills, videos;
   std::map<std::string, std::set<std::string>> sides;
   std::map<std::string, std::set<int>> frames;
+  std::map<std::string, std::vector<const RealLabel*>> of_still;
+  std::map<std::pair<std::string, int>, const RealLabel*> of_frame;
   for (const RealLabel& label : labels) {
     std::vector<std::string>& list = label.frame.has_value() ? videos : stills;
     if (std::find(list.begin(), list.end(), label.file) == list.end()) list.push_back(label.file);
     sides[label.file].insert(label.hand.empty() ? "right" : label.hand);
-    if (label.frame.has_value()) frames[label.file].insert(*label.frame);
+    if (label.frame.has_value()) {
+      frames[label.file].insert(*label.frame);
+      of_frame.emplace(std::make_pair(label.file, *label.frame), &label);
+    } else {
+      of_still[label.file].push_back(&label);
+    }
   }
+  // A label's found region, whole pixels around it.
+  auto region_of = [](const RealLabel& label) {
+    const int x0 = static_cast<int>(std::floor(label.region[0])), y0 = static_cast<int>(std::floor(label.region[1]));
+    return cv::Rect(x0, y0, static_cast<int>(std::ceil(label.region[2])) - x0, static_cast<int>(std::ceil(label.region[3])) - y0);
+  };
+  auto estimator_of = [&](const std::string& side) { return left != nullptr && side == "left" ? left : right; };
   uint64_t total = stills.size();
   for (const std::string& video : videos) total += static_cast<uint64_t>(*frames[video].rbegin() + 1);
   ProgressLine line(progress, "eval real", total, "images");
@@ -93,15 +109,19 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
     RealPrediction prediction;
     prediction.file = file;
     prediction.ms = 0.0;
-    // One estimate a labelled side, or one in all when the estimator chooses the side.
-    std::vector<Estimator*> estimators = {right};
-    if (left != nullptr) {
-      estimators.clear();
-      for (const std::string& side : sides[file]) estimators.push_back(side == "left" ? left : right);
+    // One estimate a labelled side, or one in all when the estimator chooses the side; with
+    // the place given, one a labelled hand, within its region.
+    std::vector<std::pair<Estimator*, std::optional<cv::Rect>>> estimates;
+    if (given_box) {
+      for (const RealLabel* label : of_still[file]) estimates.emplace_back(estimator_of(label->hand), region_of(*label));
+    } else if (left != nullptr) {
+      for (const std::string& side : sides[file]) estimates.emplace_back(estimator_of(side), std::nullopt);
+    } else {
+      estimates.emplace_back(right, std::nullopt);
     }
-    for (Estimator* estimator : estimators) {
+    for (const auto& [estimator, roi] : estimates) {
       estimator->Reset();
-      const FrameResult result = estimator->Process(bgr, 0.0);
+      const FrameResult result = estimator->Process(bgr, 0.0, roi);
       *prediction.ms += result.ms.total;
       if (result.detected()) prediction.hands.push_back(HandOf(result));
     }
@@ -110,7 +130,7 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
   }
   for (const std::string& file : videos) {
     // One side per video: the first labelled.
-    Estimator* estimator = left != nullptr && *sides[file].begin() == "left" ? left : right;
+    Estimator* estimator = estimator_of(*sides[file].begin());
     estimator->Reset();
     cv::VideoCapture video((root / file).string(), cv::CAP_FFMPEG);
     NPHAND_THROW_CHECK(video.isOpened(), (root / file).string(), ": cannot read this as a video");
@@ -120,7 +140,9 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
     for (int frame = 0; frame <= last; ++frame) {
       NPHAND_THROW_CHECK(video.read(bgr) && !bgr.empty(), (root / file).string(), ": ends at frame ", frame,
                          ", but frames up to ", last, " are labelled");
-      const FrameResult result = estimator->Process(bgr, frame / fps);
+      std::optional<cv::Rect> roi;
+      if (const auto it = of_frame.find({file, frame}); given_box && it != of_frame.end()) roi = region_of(*it->second);
+      const FrameResult result = estimator->Process(bgr, frame / fps, roi);
       if (frames[file].count(frame)) {
         RealPrediction prediction;
         prediction.file = file;

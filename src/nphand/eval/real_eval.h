@@ -26,9 +26,13 @@ void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem:
 // by `right` or `left` (estimators over one database, differing in their `hand`), each
 // reset first; an image without a labelled side is estimated as a right hand. Without
 // `left` (null), `right` chooses the side itself (hand_auto) and each image is estimated
-// once. `progress` (if not null) gets a progress line.
+// once. With `given_box`, the hand's place is given and only its pose is estimated: each
+// labelled hand is estimated alone, in its found region (its box grown by 25 %, see
+// real_score.h) as the estimator's region of interest, by the estimator of its side (with
+// `left`), and each labelled video frame within its label's region. `progress` (if not
+// null) gets a progress line.
 std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, const std::filesystem::path& root,
-                                         Estimator* right, Estimator* left, std::ostream* progress);
+                                         Estimator* right, Estimator* left, bool given_box, std::ostream* progress);
 
 // A contact sheet of the stills: each image with its labelled keypoints (green rings; a
 // HaGRID box as a green rectangle) and the predicted skeletons, captioned found or missed.
