@@ -127,6 +127,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   if (!options.faces) estimator_options.skin.face_cascade.clear();
   estimator_options.refine = options.refine;
   estimator_options.max_distance = options.max_distance;
+  estimator_options.k = options.k;
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, index, hand, estimator_options);
@@ -145,6 +146,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["hand"] = options.hand;
   result.figures["refine"] = options.refine;
   result.figures["max_distance"] = options.max_distance;
+  result.figures["k"] = options.k;
   result.figures["given_box"] = options.given_box;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {

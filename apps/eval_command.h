@@ -83,6 +83,7 @@ struct EvalRealCommandOptions : EstimatorFiles {
   std::string hand = "given";     // "given": the labelled side; "auto": the estimator chooses
   bool refine = false;            // the estimator refines its best view (refine/refiner.h)
   double max_distance = EstimatorOptions{}.max_distance;  // "no hand" beyond this feature distance
+  int k = EstimatorOptions{}.k;            // neighbours searched
   // The hand's place given: each labelled hand estimated within its found region (the
   // pose alone judged, apart from finding the hand).
   bool given_box = false;

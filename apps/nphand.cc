@@ -429,6 +429,7 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
   cmd->add_flag("--refine", o.refine, "Refine each estimate's best view against the hand's silhouette");
   cmd->add_option("--max-distance", o.max_distance, "No hand when the nearest view is farther than this")->capture_default_str();
+  cmd->add_option("--k", o.k, "Neighbours searched per frame")->capture_default_str();
   cmd->add_flag("--given-box", o.given_box,
                 "The hand's place given: each labelled hand estimated within its box grown by 25 % (its pose judged alone)");
   cmd->add_option("--hand", o.hand, "given (each labelled side searched for) or auto (the estimator chooses, and is scored)")

@@ -345,6 +345,12 @@ TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles
   boxed.out_dir.clear();
   const EvalRealResult given = RunEvalReal(boxed, nullptr);
   EXPECT_EQ(given.figures["given_box"], true);
+  // --k: the neighbours searched, reported; fewer than the hypotheses carried is refused.
+  EvalRealCommandOptions wider = boxed;
+  wider.k = 800;
+  EXPECT_EQ(RunEvalReal(wider, nullptr).figures["k"], 800);
+  wider.k = 3;
+  testing::ExpectError([&] { RunEvalReal(wider, nullptr); }, "within 1..k");
   // --max-distance: so strict that no view is near enough, every hand is missed.
   EvalRealCommandOptions strict = refined;
   strict.refine = false;
