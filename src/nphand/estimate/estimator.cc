@@ -27,8 +27,7 @@ double Ms(Clock::time_point from, Clock::time_point to) {
 // A hand region together with the pieces an object splits off it (skin regions whose boxes
 // meet the region's box grown by 30 % of its longer side): their pixels within `*box`, which
 // gets the pixels' bounds.
-// Only pixels within `view` count (the frame, or the caller's region of interest); an
-// empty mask (and box) when the seed has none there.
+// Only pixels within `view` count (the frame, or the caller's region of interest).
 cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, const cv::Rect& view, cv::Rect* box) {
   const cv::Rect reach = HandReach(seed.box & view);
   std::vector<int> labels = {seed.label};
