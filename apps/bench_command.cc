@@ -77,6 +77,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
   const HandModel& hand = files.hand;
   EstimatorOptions estimator_options;
   estimator_options.k = options.k;
+  estimator_options.track_views = options.track_views;
   SetHandChoice(options.hand, &estimator_options);
   estimator_options.refine = options.refine;
   Estimator estimator(db, index, hand, estimator_options);
@@ -125,6 +126,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
       {"backend", index.Backend()},
       {"index_mb", index.MemoryBytes() / 1e6},
       {"k", options.k},
+      {"track_views", options.track_views},
       {"refine", options.refine},
       {"hand", options.hand},
       {"peak_rss_mb", PeakRssMb()},

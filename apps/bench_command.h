@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/estimator_files.h"
+#include "nphand/estimate/estimator.h"
 #include "nphand/model/hand_model.h"
 
 namespace nphand {
@@ -35,6 +36,7 @@ struct BenchPipelineOptions : EstimatorFiles {
   int width = 640;
   int height = 480;
   int k = 500;
+  int track_views = EstimatorOptions{}.track_views;  // viewpoints of the track's views measured besides
   std::string hand = "right";   // right, left or auto
   bool refine = false;          // the estimator refines its best view (refine/refiner.h)
   uint64_t seed = 1;

@@ -128,6 +128,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   estimator_options.refine = options.refine;
   estimator_options.max_distance = options.max_distance;
   estimator_options.k = options.k;
+  estimator_options.track_views = options.track_views;
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, index, hand, estimator_options);
@@ -147,6 +148,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["refine"] = options.refine;
   result.figures["max_distance"] = options.max_distance;
   result.figures["k"] = options.k;
+  result.figures["track_views"] = options.track_views;
   result.figures["given_box"] = options.given_box;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {

@@ -84,6 +84,7 @@ struct EvalRealCommandOptions : EstimatorFiles {
   bool refine = false;            // the estimator refines its best view (refine/refiner.h)
   double max_distance = EstimatorOptions{}.max_distance;  // "no hand" beyond this feature distance
   int k = EstimatorOptions{}.k;            // neighbours searched
+  int track_views = EstimatorOptions{}.track_views;  // viewpoints of the track's views searched besides
   // The hand's place given: each labelled hand estimated within its found region (the
   // pose alone judged, apart from finding the hand).
   bool given_box = false;

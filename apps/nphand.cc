@@ -163,6 +163,9 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
                   "right, left (mirrored into the right-hand database) or auto (both searched; the better side kept for the track)")
       ->capture_default_str();
   cmd->add_option("--k", e.k, "Neighbours searched per frame")->capture_default_str();
+  cmd->add_option("--track-views", e.track_views,
+                  "In a track, also measure the entries of this many viewpoints nearest the last best view's (0: none)")
+      ->capture_default_str();
   cmd->add_option("--observation", o.observation, "Observation weight: fixed (the paper) or adaptive (the released code)")
       ->capture_default_str();
   cmd->add_option("--sigma-y", e.sigma_y, "Fixed observation weight's feature-distance scale")->capture_default_str();
@@ -222,6 +225,8 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
   pipeline->add_option("--width", p.width, "Frame width")->capture_default_str();
   pipeline->add_option("--height", p.height, "Frame height")->capture_default_str();
   pipeline->add_option("--k", p.k, "Neighbours per frame")->capture_default_str();
+  pipeline->add_option("--track-views", p.track_views, "Viewpoints of the track's views measured besides (0: none)")
+      ->capture_default_str();
   pipeline->add_option("--hand", p.hand, "right, left or auto (both sides searched)")->capture_default_str();
   pipeline->add_flag("--refine", p.refine, "Refine the best view's pose (its cost is ms.refine)");
   pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->check(WholeNumber())->capture_default_str();
@@ -430,6 +435,9 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_flag("--refine", o.refine, "Refine each estimate's best view against the hand's silhouette");
   cmd->add_option("--max-distance", o.max_distance, "No hand when the nearest view is farther than this")->capture_default_str();
   cmd->add_option("--k", o.k, "Neighbours searched per frame")->capture_default_str();
+  cmd->add_option("--track-views", o.track_views,
+                  "In a track, also measure the entries of this many viewpoints nearest the last best view's (0: none)")
+      ->capture_default_str();
   cmd->add_flag("--given-box", o.given_box,
                 "The hand's place given: each labelled hand estimated within its box grown by 25 % (its pose judged alone)");
   cmd->add_option("--hand", o.hand, "given (each labelled side searched for) or auto (the estimator chooses, and is scored)")

@@ -73,7 +73,7 @@ void BM_CombineWithPrior(benchmark::State& state) {
     for (int i = 0; i < x.size(); ++i) x[i] = random.Uniform(-1.0, 1.0);
   }
   std::vector<WeightedPose> carried;
-  for (int i = 0; i < state.range(0); ++i) carried.push_back({poses[i * 7], 1.0 / state.range(0)});
+  for (int i = 0; i < state.range(0); ++i) carried.push_back({poses[i * 7], 1.0 / state.range(0), {}});
   const EstimatorOptions options;
   bool used = false;
   for (auto _ : state) benchmark::DoNotOptimize(CombineWithPrior(poses, weights, carried, options, &used).data());

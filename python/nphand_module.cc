@@ -327,11 +327,12 @@ PYBIND11_MODULE(nphand, m) {
 
   py::class_<Estimate>(m, "Estimator", "Hand poses frame by frame, with the temporal prior over a video")
       .def(py::init([](std::shared_ptr<Database> db, std::shared_ptr<KnnIndex> index, std::shared_ptr<HandModel> hand,
-                       const std::string& side, int k, bool refine, bool smooth, double hand_length, double fov,
+                       const std::string& side, int k, int track_views, bool refine, bool smooth, double hand_length, double fov,
                        double focal, bool faces) {
              EstimatorOptions options;
              SetHandChoice(side, &options);
              options.k = k;
+             options.track_views = track_views;
              options.refine = refine;
              options.smooth = smooth;
              options.hand_length_m = hand_length;
@@ -343,7 +344,8 @@ PYBIND11_MODULE(nphand, m) {
              return std::make_unique<Estimate>(std::move(db), std::move(index), std::move(hand), options);
            }),
            py::arg("db"), py::arg("index"), py::arg("hand_model"), py::arg("hand") = "right", py::arg("k") = 500,
-           py::arg("refine") = false, py::arg("smooth") = true, py::arg("hand_length") = 0.18, py::arg("fov") = 60.0,
+           py::arg("track_views") = EstimatorOptions{}.track_views, py::arg("refine") = false, py::arg("smooth") = true,
+           py::arg("hand_length") = 0.18, py::arg("fov") = 60.0,
            py::arg("focal") = 0.0, py::arg("faces") = true)
       .def("process", &Estimate::Process, py::arg("frame"), py::arg("time_s") = py::none(), py::arg("roi") = py::none(),
            "Estimates the hand in the next frame (H x W x 3 uint8 BGR); time_s defaults to 1/30 s after the last; "

@@ -98,6 +98,8 @@ def test_bad_frames_are_refused(hand, tiny):
         estimator.process(np.zeros((48, 64), np.uint8))
     with pytest.raises(nphand.Error, match="estimator: "):
         nphand.Estimator(db, index, hand, k=0)
+    with pytest.raises(nphand.Error, match="track's views must be within 0..64"):
+        nphand.Estimator(db, index, hand, track_views=65)
     # A frame with nothing in it is "no hand", not an error.
     assert not estimator.process(np.zeros((48, 64, 3), np.uint8)).detected
     with pytest.raises(nphand.Error, match="width and height above 0"):

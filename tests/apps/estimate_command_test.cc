@@ -351,6 +351,12 @@ TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles
   EXPECT_EQ(RunEvalReal(wider, nullptr).figures["k"], 800);
   wider.k = 3;
   testing::ExpectError([&] { RunEvalReal(wider, nullptr); }, "within 1..k");
+  // --track-views: reported; beyond 64 refused.
+  EvalRealCommandOptions views = boxed;
+  views.track_views = 0;
+  EXPECT_EQ(RunEvalReal(views, nullptr).figures["track_views"], 0);
+  views.track_views = 65;
+  testing::ExpectError([&] { RunEvalReal(views, nullptr); }, "track's views");
   // --max-distance: so strict that no view is near enough, every hand is missed.
   EvalRealCommandOptions strict = refined;
   strict.refine = false;

@@ -293,7 +293,7 @@ TEST(CombineWithPriorTest, WeightsAreNormalisedAndTwoModesSurviveUntilTheObserva
   options.prior = PriorCombination::kProduct;
   options.sigma_x = 0.3;
   // The previous frame left two equal modes.
-  const std::vector<WeightedPose> carried = {{a, 0.5}, {b, 0.5}};
+  const std::vector<WeightedPose> carried = {{a, 0.5, {}}, {b, 0.5, {}}};
   // Hypotheses near each mode, and one far from both.
   PoseX near_a = a, near_b = b, elsewhere = PoseX::Zero();
   near_a[10] = 0.05;
@@ -308,7 +308,7 @@ TEST(CombineWithPriorTest, WeightsAreNormalisedAndTwoModesSurviveUntilTheObserva
   EXPECT_NEAR(w[0], w[1], 1e-9);
   EXPECT_LT(w[2], 1e-6);
   // The next frame carries both; an observation that favours one settles it.
-  const std::vector<WeightedPose> both = {{near_a, w[0]}, {near_b, w[1]}};
+  const std::vector<WeightedPose> both = {{near_a, w[0], {}}, {near_b, w[1], {}}};
   w = CombineWithPrior(poses, {0.8, 0.1, 0.1}, both, options, &used);
   EXPECT_GT(w[0], 0.85);
   // The weighted sum keeps some of the observation; no prior gives the observation back.
@@ -321,7 +321,7 @@ TEST(CombineWithPriorTest, WeightsAreNormalisedAndTwoModesSurviveUntilTheObserva
   EXPECT_EQ(w, (std::vector<double>{0.3, 0.3, 0.4}));
   // A prior that gives nothing to any hypothesis (the hand jumped) is dropped.
   PoseX far = PoseX::Constant(50.0);
-  w = CombineWithPrior(poses, {0.3, 0.3, 0.4}, {{far, 1.0}}, options, &used);
+  w = CombineWithPrior(poses, {0.3, 0.3, 0.4}, {{far, 1.0, {}}}, options, &used);
   EXPECT_FALSE(used);
 }
 
@@ -645,10 +645,43 @@ TEST_F(EstimatorTest, ARegionOfInterestConfinesTheSearch) {
   testing::ExpectError([&] { estimator.Process(bgr, 0.0, cv::Rect(700, 0, 50, 50)); }, "does not meet the 640 x 240 frame");
 }
 
+// In a track the entries seen from the viewpoints nearest the last frame's best join the
+// K neighbours: with K = 1 a lone frame weighs one entry, the track's second frame many (of
+// both grasps the database holds), and the best stays the frame's own entry.
+TEST_F(EstimatorTest, TheTracksViewsJoinTheNeighboursInATrack) {
+  const size_t e = EntryWithoutObject(*db_, 400);
+  EstimatorOptions options = Options();
+  options.k = options.carried = options.top_n = 1;
+  options.roll_ambiguity = 0.0;  // one crop, one search
+  const auto track = [&](int views) {
+    options.track_views = views;
+    Estimator estimator(*db_, *index_, RightHand(), options);
+    const cv::Mat mask = estimator.RenderEntry(static_cast<uint32_t>(e)).labels == static_cast<int>(PixelLabel::kHand);
+    return std::vector<FrameResult>{estimator.ProcessMask(mask, 0.0), estimator.ProcessMask(mask, 1.0 / 30)};
+  };
+  const std::vector<FrameResult> alone = track(0), tracked = track(4);
+  for (const FrameResult& r : {alone[0], alone[1], tracked[0], tracked[1]}) {
+    ASSERT_TRUE(r.detected()) << r.reason;
+    EXPECT_EQ(r.top[0].entry, e);
+    EXPECT_NEAR(r.nearest_distance, 0.0, 1e-3);
+  }
+  EXPECT_EQ(alone[1].effective_samples, 1.0);
+  EXPECT_EQ(alone[1].grasps.size(), 1u);
+  EXPECT_EQ(tracked[0].effective_samples, 1.0) << "no track yet on the first frame";
+  EXPECT_GT(tracked[1].effective_samples, 1.0);
+  EXPECT_EQ(tracked[1].grasps.size(), 2u);
+  const std::vector<FrameResult> again = track(4);
+  EXPECT_EQ(again[1].effective_samples, tracked[1].effective_samples);
+  EXPECT_EQ(again[1].confidence, tracked[1].confidence);
+}
+
 TEST_F(EstimatorTest, BadSetUpsAreRefused) {
   EstimatorOptions options = Options();
   options.k = 0;
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "k must be");
+  options = Options();
+  options.track_views = 65;
+  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "track's views must be within 0..64");
   options = Options();
   options.min_hand_px = 0;
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "smallest hand");

@@ -176,6 +176,28 @@ TEST_P(BackendTest, BatchSearchEqualsOneAtATime) {
   }
 }
 
+// Distances to chosen entries are measured as the search measures them: those of the
+// entries a search found are its own; an entry the index does not hold is refused by name.
+TEST_P(BackendTest, DistancesToChosenEntriesAreTheSearchsOwn) {
+  const IndexedSet all = DatabaseDescriptors(db());
+  const std::unique_ptr<KnnIndex> index = BuildIndex(Half(all, 0), GetParam().approximate);
+  for (size_t q : {size_t{1}, size_t{64}, size_t{151}}) {
+    const Neighbours found = index->Search(QueryOf(all.ids[q]), 12);
+    std::vector<entry_id_t> ids(found.ids.rbegin(), found.ids.rend());  // in another order
+    std::vector<float> distances;
+    ASSERT_TRUE(index->Distances(QueryOf(all.ids[q]), ids, &distances));
+    ASSERT_EQ(distances.size(), ids.size());
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const float want = found.distances[found.ids.size() - 1 - i];
+      EXPECT_NEAR(distances[i], want, 1e-5f * std::max(1.0f, want)) << q << " entry " << ids[i];
+    }
+  }
+  std::vector<float> untouched = {7.0f};
+  testing::ExpectError([&] { index->Distances(QueryOf(all.ids[0]), std::vector<entry_id_t>{all.ids[1]}, &untouched); },
+                       "entry " + std::to_string(all.ids[1]) + " is not in the index");
+  EXPECT_EQ(untouched, std::vector<float>{7.0f});
+}
+
 INSTANTIATE_TEST_SUITE_P(All, BackendTest, ::testing::ValuesIn(Cases()), [](const auto& info) {
   std::string name = info.param.name;
   for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';

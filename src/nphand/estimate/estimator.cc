@@ -153,6 +153,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "sigma_y must be within (0, 10) and sigma_x within (0, 100)";
   } else if (!(prior_share >= 0.0 && prior_share <= 1.0)) {
     *why = "the prior's share must be within [0, 1]";
+  } else if (track_views < 0 || track_views > 64) {
+    *why = "the track's views must be within 0..64";
   } else if (carried < 1 || carried > k || top_n < 1 || top_n > k) {
     *why = "carried hypotheses and top-N must be within 1..k";
   } else if (!(roll_ambiguity >= 0.0 && roll_ambiguity < 10.0) || !(max_distance > 0.0 && max_distance < 10.0)) {
@@ -248,6 +250,23 @@ Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel&
     for (int j = 0; j < kNumDofs; ++j) row.angles[j] = static_cast<float>(angles[j]);
     with_object[row.meta.grasp] = with_object[row.meta.grasp] || row.meta.with_object;
   });
+  if (options.track_views > 0) {
+    view_entries_.resize(directions_.size());
+    for (entry_id_t id : index.ids()) view_entries_[entries_[id].meta.viewpoint].push_back(id);
+    const size_t nearest = std::min<size_t>(options.track_views, directions_.size());
+    near_views_.resize(directions_.size());
+    for (size_t v = 0; v < directions_.size(); ++v) {
+      std::vector<int> by_angle(directions_.size());
+      for (size_t w = 0; w < by_angle.size(); ++w) by_angle[w] = static_cast<int>(w);
+      // Nearest first; ties by number, so that the choice is the same on every machine.
+      std::partial_sort(by_angle.begin(), by_angle.begin() + nearest, by_angle.end(), [&](int a, int b) {
+        const double da = directions_[v].dot(directions_[a]), db = directions_[v].dot(directions_[b]);
+        return da != db ? da > db : a < b;
+      });
+      near_views_[v].assign(by_angle.begin(), by_angle.begin() + nearest);
+    }
+    found_in_.assign(entries_.size(), 0);
+  }
   // The grasps whose objects the database shows, closed onto them now, on every core: a
   // grasp takes about 100 ms, far too long to make on the frame that first needs it.
   std::vector<int> held;
@@ -592,9 +611,31 @@ bool Estimator::Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame,
   return true;
 }
 
-void Estimator::Search(Lookup* lookup, FrameResult* result) const {
+void Estimator::Search(Lookup* lookup, FrameResult* result) {
   const Clock::time_point t = Clock::now();
   for (const Descriptor& d : lookup->descriptors) lookup->found.push_back(index_.Search(d, options_.k));
+  if (options_.track_views > 0 && !carried_.empty() && carried_[0].entry.has_value()) {
+    const std::vector<int>& views = near_views_[entries_[*carried_[0].entry].meta.viewpoint];
+    std::vector<entry_id_t> more;
+    std::vector<float> distances;
+    for (size_t c = 0; c < lookup->descriptors.size(); ++c) {
+      Neighbours& found = lookup->found[c];
+      if (++searches_ == 0) {  // the counter wrapped: forget every mark
+        std::fill(found_in_.begin(), found_in_.end(), 0);
+        searches_ = 1;
+      }
+      for (entry_id_t id : found.ids) found_in_[id] = searches_;
+      more.clear();
+      for (int view : views) {
+        for (entry_id_t id : view_entries_[view]) {
+          if (found_in_[id] != searches_) more.push_back(id);
+        }
+      }
+      if (!index_.Distances(lookup->descriptors[c], more, &distances)) break;
+      found.ids.insert(found.ids.end(), more.begin(), more.end());
+      found.distances.insert(found.distances.end(), distances.begin(), distances.end());
+    }
+  }
   result->ms.search = Ms(t, Clock::now());
 }
 
@@ -684,7 +725,7 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
   carried_.clear();
   double carried_sum = 0.0;
   for (size_t r = 0; r < order.size() && static_cast<int>(r) < options_.carried; ++r) {
-    carried_.push_back({hyp[order[r]].x, hyp[order[r]].w});
+    carried_.push_back({hyp[order[r]].x, hyp[order[r]].w, hyp[order[r]].entry});
     carried_sum += hyp[order[r]].w;
   }
   for (WeightedPose& c : carried_) c.weight = carried_sum > 0.0 ? c.weight / carried_sum : 1.0 / carried_.size();

@@ -56,6 +56,12 @@ struct EstimatorOptions {
   double sigma_x = 0.5;                         // the prior's kernel width in pose-vector units
   double prior_share = 0.9;                     // kSum's weight on the prior
   int carried = 5;                              // hypotheses carried to the next frame
+  // The track's views: in a track, the entries seen from the `track_views` viewpoints
+  // nearest the last frame's best (its own first) join the K neighbours, measured against the
+  // frame's descriptor, so that the prior finds the views near its track even where an
+  // outline alike from the palm and the back fills the K nearest with the other side's
+  // (docs/estimator.md). 0: none.
+  int track_views = 4;
   int top_n = 5;                                // hypotheses in each result
   // Search the half-turned crop too when the silhouette's skewness is below this (its two
   // ends look alike, so the principal axis's direction is a guess). The sweep's choice:
@@ -175,6 +181,7 @@ using PoseX = Eigen::Matrix<double, kPoseVectorSize, 1>;  // the paper's pose ve
 struct WeightedPose {
   PoseX x;
   double weight;
+  std::optional<uint32_t> entry;  // the database entry it is (none: a pose from elsewhere)
 };
 
 // The temporal step: hypotheses' observation weights (normalised) combined with the kernel
@@ -233,7 +240,9 @@ class Estimator {
   // The crop (and its half turn) and their descriptors; false (with the reason) for a
   // silhouette too thin to be a hand.
   bool Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, Lookup* lookup, FrameResult* result);
-  void Search(Lookup* lookup, FrameResult* result) const;
+  // The K neighbours of each descriptor, and in a track the entries of the track's views
+  // (measured by the index; none where the backend keeps nothing to measure with).
+  void Search(Lookup* lookup, FrameResult* result);
   // Hypotheses, observation weights, the prior, the carried hypotheses, the posteriors and
   // the top-N; false (with the reason) when nothing in the database is near.
   bool Weigh(cv::Rect box, Lookup* lookup, FrameResult* result);
@@ -303,6 +312,12 @@ class Estimator {
   std::array<Refined, 2> refined_;         // by side (right, left): the latest
   std::array<Refined, 2> refined_before_;  // by side: the latest of an earlier frame than refined_'s
   std::vector<WeightedPose> carried_;
+  // track_views: by viewpoint, the entries the index holds and the track_views nearest
+  // viewpoints (itself first); per entry, the search that last found it.
+  std::vector<std::vector<entry_id_t>> view_entries_;
+  std::vector<std::vector<int>> near_views_;
+  std::vector<uint32_t> found_in_;
+  uint32_t searches_ = 0;
   std::optional<cv::Point2d> last_centre_;
   OneEuroFilter smooth_wrist_, smooth_image_, smooth_angles_, smooth_rotation_;
   Handedness smoothed_side_ = Handedness::kRight;

@@ -148,6 +148,10 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
       e.carried = std::min(e.carried, k);
     });
   }
+  // The track's views: none, or more viewpoints of them than the default's.
+  for (int views : {0, 8}) {
+    around_default("track-views" + std::to_string(views), [&](EstimatorOptions& e) { e.track_views = views; });
+  }
   return out;
 }
 

@@ -228,6 +228,18 @@ class HnswlibIndex : public KnnIndex {
     });
   }
 
+  bool RowDistances(std::span<const float> query, std::span<const uint32_t> rows, float* out) const override {
+    if (!sq8_) return KnnIndex::RowDistances(query, rows, out);
+    std::vector<uint8_t> codes(query.size());
+    Encode(query, sq8_->step, codes.data());
+    const float step_squared = sq8_->step * sq8_->step;
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const auto* node = reinterpret_cast<const uint8_t*>(graph_->getDataByInternalId(static_cast<hnswlib::tableint>(rows[i])));
+      out[i] = static_cast<float>(CodeDistance(codes.data(), node, codes.size())) * step_squared;
+    }
+    return true;
+  }
+
   std::string Backend() const override { return sq8_ ? "hnswlib-sq8" : "hnswlib"; }
   nlohmann::json Parameters() const override { return options_.ToJson(); }
   size_t MemoryBytes() const override {

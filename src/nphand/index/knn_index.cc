@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Core>
+
 #include "nphand/index/index_file.h"
 #include "nphand/util/check.h"
 #include "nphand/util/parallel.h"
@@ -39,19 +41,51 @@ IndexedSet DatabaseDescriptors(const Database& db, std::vector<entry_id_t> ids) 
   return {std::move(descriptors), std::move(ids)};
 }
 
-Neighbours KnnIndex::Search(const Descriptor& query, int k) const {
-  CheckSameDescriptor(config(), query.config, "the query");
-  NPHAND_THROW_CHECK(k >= 1, "search: k must be at least 1, not ", k);
-  NPHAND_THROW_CHECK(query.values.size() == static_cast<size_t>(config().Dimension()), "search: the query has ",
-                     query.values.size(), " values, the index ", config().Dimension());
+namespace {
+
+void CheckQuery(const DescriptorConfig& config, const Descriptor& query) {
+  CheckSameDescriptor(config, query.config, "the query");
+  NPHAND_THROW_CHECK(query.values.size() == static_cast<size_t>(config.Dimension()), "search: the query has ",
+                     query.values.size(), " values, the index ", config.Dimension());
   NPHAND_THROW_CHECK(std::all_of(query.values.begin(), query.values.end(), [](float v) { return std::isfinite(v); }),
                      "search: the query has a value that is not a finite number");
+}
+
+}  // namespace
+
+Neighbours KnnIndex::Search(const Descriptor& query, int k) const {
+  NPHAND_THROW_CHECK(k >= 1, "search: k must be at least 1, not ", k);
+  CheckQuery(config(), query);
   Neighbours neighbours;
   for (const auto& [distance, row] : SearchRows(query.values, k)) {
     neighbours.ids.push_back(set_.ids[row]);
     neighbours.distances.push_back(distance);
   }
   return neighbours;
+}
+
+bool KnnIndex::Distances(const Descriptor& query, std::span<const entry_id_t> ids, std::vector<float>* out) const {
+  CheckQuery(config(), query);
+  std::vector<uint32_t> rows(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const auto at = std::lower_bound(set_.ids.begin(), set_.ids.end(), ids[i]);
+    NPHAND_THROW_CHECK(at != set_.ids.end() && *at == ids[i], "search: entry ", ids[i], " is not in the index");
+    rows[i] = static_cast<uint32_t>(at - set_.ids.begin());
+  }
+  std::vector<float> distances(ids.size());
+  if (!RowDistances(query.values, rows, distances.data())) return false;
+  *out = std::move(distances);
+  return true;
+}
+
+bool KnnIndex::RowDistances(std::span<const float> query, std::span<const uint32_t> rows, float* out) const {
+  if (set_.descriptors.rows() != size()) return false;
+  const Eigen::Map<const Eigen::VectorXf> q(query.data(), static_cast<Eigen::Index>(query.size()));
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const std::span<const float> row = set_.descriptors.Row(rows[i]);
+    out[i] = (q - Eigen::Map<const Eigen::VectorXf>(row.data(), static_cast<Eigen::Index>(row.size()))).squaredNorm();
+  }
+  return true;
 }
 
 std::vector<Neighbours> KnnIndex::SearchBatch(const DescriptorMatrix& queries, int k, int threads) const {

@@ -67,6 +67,12 @@ class KnnIndex {
   // The k nearest entries of `query` (all of them when the index holds fewer). Throws
   // nphand::Error, naming both configs, when the query was described differently.
   Neighbours Search(const Descriptor& query, int k) const;
+  // The squared distances from `query` to the entries `ids` (each one the index holds), as
+  // its search measures them (an index of 8-bit codes by the codes), into `out`. False,
+  // `out` untouched, for a backend that keeps nothing to measure with. Throws as Search.
+  bool Distances(const Descriptor& query, std::span<const entry_id_t> ids, std::vector<float>* out) const;
+  // The entries the index holds, ascending.
+  const std::vector<entry_id_t>& ids() const { return set_.ids; }
   // Search for every row of `queries`, on `threads` threads (0: all cores); equal to one
   // Search per row.
   std::vector<Neighbours> SearchBatch(const DescriptorMatrix& queries, int k, int threads = 1) const;
@@ -83,6 +89,8 @@ class KnnIndex {
   const IndexedSet& set() const { return set_; }
   // The k nearest rows of the set: (squared distance, row), ascending, ties by row.
   virtual std::vector<std::pair<float, uint32_t>> SearchRows(std::span<const float> query, int k) const = 0;
+  // Distances for rows; this one measures the set's descriptor rows (false without them).
+  virtual bool RowDistances(std::span<const float> query, std::span<const uint32_t> rows, float* out) const;
   // What the backend needs, beyond the set, to be loaded again.
   virtual std::vector<uint8_t> Body() const = 0;
 
