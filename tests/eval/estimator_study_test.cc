@@ -39,6 +39,8 @@ TEST_F(EstimatorStudyTest, EverySettingIsNamedOnceAndVariesWhatItSays) {
   EXPECT_EQ(find("nn").options.prior, PriorCombination::kNone);
   EXPECT_EQ(find("turns0").options.roll_ambiguity, 0.0);
   EXPECT_EQ(find("k50").options.k, 50);
+  EXPECT_EQ(find("k250").options.k, 250);
+  EXPECT_EQ(find("k2000").options.k, 2000);
   EXPECT_EQ(find("track-views0").options.track_views, 0);
   EXPECT_EQ(find("track-views8").options.track_views, 8);
   EXPECT_EQ(find("carried20").options.carried, 20);

@@ -142,7 +142,7 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
       });
     }
   }
-  for (int k : {50, 100, 2000}) {
+  for (int k : {50, 100, 250, 2000}) {
     around_default("k" + std::to_string(k), [&](EstimatorOptions& e) {
       e.k = k;
       e.carried = std::min(e.carried, k);
