@@ -124,6 +124,11 @@ void AddSequenceCommand(CLI::App& app, nphand::SequenceCommandOptions& o) {
   cmd->add_option("--distance", s.distance_m, "Camera to hand, metres (average)")->capture_default_str();
   cmd->add_option("--noise", s.noise, "Sensor noise, standard deviation in 8-bit levels")->capture_default_str();
   cmd->add_option("--hand", o.hand, "right or left (the right hand's mirror image)")->capture_default_str();
+  cmd->add_option("--proportions", o.proportions,
+                  "LENGTH,WIDTH: the hand's length and width as factors of the database hand's (each within 0.5..2)")
+      ->delimiter(',')
+      ->expected(2)
+      ->capture_default_str();
   cmd->add_option("--seed", s.seed, "Seed of every random choice")->check(WholeNumber())->capture_default_str();
   cmd->add_flag("--video", o.video, "Also write video.mp4");
   cmd->add_option("--out", o.out_dir, "Output folder")->capture_default_str();
@@ -193,7 +198,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_flag("--refine,!--no-refine", e.refine, "Refine the best view's pose until its silhouette agrees with the hand's");
   cmd->add_option("--refine-sweeps", e.refinement.sweeps, "Refinement: passes over the wrist's and fingers' directions")
       ->capture_default_str();
-  cmd->add_option("--refine-move", o.refine_move, "Refinement: what moves, any of place, wrist and fingers")
+  cmd->add_option("--refine-move", o.refine_move, "Refinement: what moves, any of place, wrist, fingers and proportions")
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_flag("--smooth,!--no-smooth", e.smooth, "Smooth the track's poses over time (a One Euro filter)")->capture_default_str();

@@ -23,9 +23,12 @@ nlohmann::json RunSequence(const SequenceCommandOptions& options, std::ostream* 
   CheckOutputFolder(options.out_dir / "frames", "--out");
   CheckOutputFolder(options.out_dir / "labels", "--out");
 
-  const HandModel hand = HandModel::Load(Handedness::kRight, options.asset_dir);
+  NPHAND_THROW_CHECK(options.proportions.size() == 2, "sequence: --proportions takes two factors, length and width");
+  const HandModel hand =
+      HandModel::Load(Handedness::kRight, options.asset_dir).Reproportioned(options.proportions[0], options.proportions[1]);
   Sequence sequence(hand, sequence_options);
   nlohmann::json description = sequence.Describe();
+  description["hand_proportions"] = {{"length", options.proportions[0]}, {"width", options.proportions[1]}};
   description["files"] = {{"frames", "frames/%06d.png"}, {"labels", "labels/%06d.png"}, {"truth", "truth.jsonl"}};
 
   std::optional<VideoFile> video;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -20,6 +21,9 @@ struct SequenceCommandOptions {
   std::string forearm = "bare";          // none | bare | sleeved
   std::string background = "texture";   // plain | texture | clutter
   std::string hand = "right";
+  // The hand's length and width as factors of the database hand's (HandModel::Reproportioned):
+  // a hand unlike the one the database was rendered from.
+  std::vector<double> proportions = {1.0, 1.0};
   bool video = false;                    // also write video.mp4 (MPEG-4 part 2)
   std::filesystem::path out_dir = "out/sequence";
   std::filesystem::path asset_dir = DefaultAssetDir();

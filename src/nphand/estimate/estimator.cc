@@ -18,6 +18,13 @@
 namespace nphand {
 namespace {
 
+// The median of `values` (the mean of the middle two for an even count); none empty.
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
 using Clock = std::chrono::steady_clock;
 
 double Ms(Clock::time_point from, Clock::time_point to) {
@@ -299,6 +306,9 @@ void Estimator::Reset() {
   side_frame_ = -1;
   refined_ = {};
   refined_before_ = {};
+  widths_.clear();
+  width_ = 1.0;
+  width_held_ = false;
   ResetSmoothing();
   smoothed_side_ = options_.hand;
 }
@@ -398,7 +408,8 @@ void Estimator::Smooth(FrameResult* r) {
   // The keypoints are the smoothed pose's, so that they stay a hand's and agree with the
   // angles and the rotation: a left hand's are the mirrored right hand's the database holds.
   const bool left = r->hand == Handedness::kLeft;
-  Keypoints3d keypoints = hand_.KeypointsOf(left ? MirrorPose(r->pose) : r->pose);
+  const HandModel& model = r->proportions.has_value() ? refiner_->Model(r->proportions->width / r->proportions->length) : hand_;
+  Keypoints3d keypoints = model.KeypointsOf(left ? MirrorPose(r->pose) : r->pose);
   const double size = length / model_hand_length_;
   for (int k = 0; k < kNumKeypoints; ++k) {
     if (left) keypoints[k].x() = -keypoints[k].x();
@@ -792,11 +803,15 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
     Refinement r;
     double from_last;  // degrees from the last frame's refined rotation (0 without one)
   };
+  const bool move_width = options_.refinement.move_proportions && !width_held_;
   auto attempt = [&](const Candidate& c) {
     const cv::Matx23d start_map = PlacementOf(c.entry).crop_from_image;
     // The track's last rotation in this entry's image plane.
     const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -c.turn) * before;
-    Tried tried{&c, refiner_->Refine(lookup.crops[c.turn_of], EntryScene(c.entry), start_map, track ? &previous : nullptr), 0.0};
+    Tried tried{&c,
+                refiner_->Refine(lookup.crops[c.turn_of], EntryScene(c.entry), start_map, track ? &previous : nullptr, width_,
+                                 move_width),
+                0.0};
     if (last) tried.from_last = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), c.turn) * RotationOf(tried.r), before);
     return tried;
   };
@@ -816,9 +831,27 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
   const Refinement& r = chosen.r;
   result->refined = r.moved || &c != &best;
   result->refine_objective = std::make_pair(r.objective_before, r.objective_after);
+  if (options_.refinement.move_proportions) {
+    // A frame's measurement counts if the silhouette of its start's pose at that width agrees
+    // with the hand's: a wrong pose favours a wrong width.
+    if (move_width && r.width_disagreement <= kWidthFit) {
+      widths_.push_back(r.width_measured);
+      if (widths_.size() >= kWidthFrames) {
+        std::vector<double> last(widths_.end() - kWidthFrames, widths_.end());
+        std::sort(last.begin(), last.end());
+        if (last[3 * kWidthFrames / 4] - last[kWidthFrames / 4] <= kWidthSpread) {
+          width_held_ = true;
+          width_ = WidthOnGrid(Median(widths_));
+        }
+      }
+    }
+    const double length = options_.hand_length_m / model_hand_length_;
+    result->proportions = FrameResult::Proportions{length, length * r.width, !move_width};
+  }
   std::optional<EntryPlacement> refined;
-  if (result->refined) {
-    refined = EntryPlacement{c.entry, 0, r.crop_from_image, hand_.KeypointsOf(r.scene.hand), r.scene.wrist_in_camera};
+  if (result->refined || r.width != 1.0) {
+    refined = EntryPlacement{c.entry, 0, r.crop_from_image, refiner_->Model(r.width).KeypointsOf(r.scene.hand),
+                             r.scene.wrist_in_camera};
     // The silhouette turned counter-clockwise in the crop stands for a hand turned the
     // other way in the frame.
     *turn = c.turn - r.turn;

@@ -173,6 +173,17 @@ struct FrameResult {
   // pulls towards the start and the last frame's rotation) before and after.
   bool refined = false;
   std::optional<std::pair<double, double>> refine_objective;
+  // With refine measuring the proportions (RefineOptions::move_proportions): the hand's
+  // length and width as factors of the database hand's. The length is hand_length_m's; the
+  // width the database's until the video's measurements settle, then theirs (`held`, no
+  // longer measured). The frame's pose was refined, and its keypoints made, for a hand of
+  // these proportions.
+  struct Proportions {
+    double length = 1.0;
+    double width = 1.0;
+    bool held = false;
+  };
+  std::optional<Proportions> proportions;
   StageMilliseconds ms;
 };
 
@@ -311,6 +322,16 @@ class Estimator {
   };
   std::array<Refined, 2> refined_;         // by side (right, left): the latest
   std::array<Refined, 2> refined_before_;  // by side: the latest of an earlier frame than refined_'s
+  // With the proportions measured: the video's frames' widths (against the length) where
+  // the silhouette at the width measured agreed within kWidthFit, and the width used: the
+  // database's (1) until the last kWidthFrames measurements' middle half spans at most
+  // kWidthSpread, then their whole median, held (no longer measured).
+  std::vector<double> widths_;
+  double width_ = 1.0;
+  bool width_held_ = false;
+  static constexpr size_t kWidthFrames = 10;
+  static constexpr double kWidthSpread = 0.03;
+  static constexpr double kWidthFit = 0.15;
   std::vector<WeightedPose> carried_;
   // track_views: by viewpoint, the entries the index holds and the track_views nearest
   // viewpoints (itself first); per entry, the search that last found it.

@@ -62,6 +62,9 @@ nlohmann::json FrameResultJson(const FrameResult& r, const Database& db, bool wi
     j["refined"] = r.refined;
     j["refine_objective"] = {{"before", r.refine_objective->first}, {"after", r.refine_objective->second}};
   }
+  if (r.proportions.has_value()) {
+    j["proportions"] = {{"length", r.proportions->length}, {"width", r.proportions->width}, {"held", r.proportions->held}};
+  }
   j["grasps"] = Posterior(r.grasps, "grasp");
   j["objects"] = Posterior(r.objects, "object");
   j["confidence"] = r.confidence;

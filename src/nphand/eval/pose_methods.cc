@@ -101,6 +101,7 @@ class EstimatorMethod : public PoseMethod {
     if (out.detected) {
       out.pose = r.pose;
       out.keypoints_2d = r.keypoints_2d;
+      if (r.proportions.has_value()) out.keypoints_hand = r.keypoints_hand;
     }
     return out;
   }
@@ -144,7 +145,7 @@ class NearestPoseMethod : public PoseMethod {
         best_roll = roll;
       }
     }
-    return {true, PoseInFrame(best_x, best_roll, view->towards_ray), std::nullopt};
+    return {true, PoseInFrame(best_x, best_roll, view->towards_ray), std::nullopt, std::nullopt};
   }
 
  private:
@@ -159,7 +160,7 @@ class MeanPoseMethod : public PoseMethod {
   MethodEstimate Estimate(const StudyFrame& frame, const cv::Mat& mask) override {
     const std::optional<MaskView> view = ViewOf(mask, config_, frame.intrinsics);
     if (!view) return {};
-    return {true, PoseInFrame(mean_, view->crop.roll, view->towards_ray), std::nullopt};
+    return {true, PoseInFrame(mean_, view->crop.roll, view->towards_ray), std::nullopt, std::nullopt};
   }
 
  private:
@@ -203,7 +204,7 @@ class RegressionMethod : public PoseMethod {
     Eigen::MatrixXd x(1, config_.Dimension());
     for (int c = 0; c < config_.Dimension(); ++c) x(0, c) = view->descriptor.values[c];
     const PoseVector predicted = regressor_->Predict(x).row(0).transpose();
-    return {true, PoseInFrame(predicted, view->crop.roll, view->towards_ray), std::nullopt};
+    return {true, PoseInFrame(predicted, view->crop.roll, view->towards_ray), std::nullopt, std::nullopt};
   }
   nlohmann::json Describe() const override {
     const RegressorSummary s = regressor_->Summary();

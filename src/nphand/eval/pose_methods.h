@@ -31,6 +31,10 @@ struct MethodEstimate {
   bool detected = false;
   HandPose pose;  // in the frame's camera
   std::optional<std::array<Eigen::Vector2d, kNumKeypoints>> keypoints_2d;  // methods that place the hand
+  // The method's own 3D keypoints (hand-centred, camera orientation, for a hand of the
+  // database hand's length) where they are not the database hand's in `pose`: a hand of
+  // estimated proportions.
+  std::optional<Keypoints3d> keypoints_hand;
 };
 
 // One interface for every method of the comparison. Estimate sees the frame (for the

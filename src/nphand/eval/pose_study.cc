@@ -250,7 +250,7 @@ std::vector<MethodScore> RunMethods(std::vector<std::unique_ptr<PoseMethod>>& me
           if (e.detected) {
             const HandPose& truth = frame.truth.pose;
             f.pose_error = (ToPoseVector(e.pose) - ToPoseVector(truth)).norm();
-            f.estimate = hand.KeypointsOf(e.pose);
+            f.estimate = e.keypoints_hand.has_value() ? *e.keypoints_hand : hand.KeypointsOf(e.pose);
             for (Eigen::Vector3d& k : f.estimate) k *= frame.hand_length_m / model_length;
             f.truth = frame.truth.keypoints;
             f.distances = RootRelativeDistances(f.estimate, f.truth);
@@ -374,11 +374,20 @@ PoseStudyResult RunPoseStudy(PoseStudyPart part, const Database& db, const KnnIn
   smoothed.smooth = true;
   EstimatorOptions both = refined;
   both.smooth = true;
+  // The hand's proportions measured too: for the robustness study's hand unlike the model.
+  EstimatorOptions proportioned = refined;
+  proportioned.refinement.move_proportions = true;
   methods.push_back(MakeEstimatorMethod("PNP", db, index, hand, pnp, false));
   methods.push_back(MakeEstimatorMethod("PNP + refine", db, index, hand, refined, false));
+  if (part == PoseStudyPart::kRobustness) {
+    methods.push_back(MakeEstimatorMethod("PNP + refine + proportions", db, index, hand, proportioned, false));
+  }
   methods.push_back(MakeEstimatorMethod("PNP + smooth", db, index, hand, smoothed, false));
   methods.push_back(MakeEstimatorMethod("PNP RGB", db, index, hand, pnp, true));
   methods.push_back(MakeEstimatorMethod("PNP RGB + refine", db, index, hand, refined, true));
+  if (part == PoseStudyPart::kRobustness) {
+    methods.push_back(MakeEstimatorMethod("PNP RGB + refine + proportions", db, index, hand, proportioned, true));
+  }
   methods.push_back(MakeEstimatorMethod("PNP RGB + smooth", db, index, hand, smoothed, true));
   methods.push_back(MakeEstimatorMethod("PNP RGB + refine + smooth", db, index, hand, both, true));
   methods.push_back(MakeEstimatorMethod("NN feature", db, index, hand, nn_feature, false));

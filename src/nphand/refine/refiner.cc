@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <vector>
 
@@ -18,15 +19,18 @@ namespace {
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 // The parameters: the wrist's turns about the camera's x and y axes (across the view; the
 // turn within it is the place's), the joints, then the silhouette's place in the crop:
-// shift (x, y, crop pixels), log scale, turn (radians, counter-clockwise as displayed).
+// shift (x, y, crop pixels), log scale, turn (radians, counter-clockwise as displayed); then
+// the hand's width factor.
 constexpr int kWristAxes = 2;
 constexpr int kPlace = kWristAxes + kNumDofs;
-constexpr int kParameters = kPlace + 4;
+constexpr int kWidth = kPlace + 4;
+constexpr int kParameters = kWidth + 1;
 constexpr int kRepeats = 4;  // steps taken in a row along a direction that keeps improving
+constexpr int kPlaceSweeps = 3;  // passes over the place's directions settling a width's trial (steps from half the first)
 using Parameters = std::array<double, kParameters>;
 
 // A direction of the search: parameters moved together, each by its weight times the step.
-enum class Kind : uint8_t { kWrist, kJoint, kShift, kScale, kTurn };
+enum class Kind : uint8_t { kWrist, kJoint, kShift, kScale, kTurn, kWidth };
 struct Direction {
   std::vector<std::pair<int, double>> moves;
   Kind kind = Kind::kJoint;
@@ -34,7 +38,7 @@ struct Direction {
 
 // The silhouette's place; the wrist's two axes; the thumb's five joints one by one; for each
 // finger its curl (all three flexions), its MCP flexion, its PIP and DIP together, and its
-// spread.
+// spread. (The width is measured apart: Refiner::Refine.)
 std::vector<Direction> Directions(const RefineOptions& options) {
   std::vector<Direction> out;
   if (options.move_place) {
@@ -57,6 +61,13 @@ std::vector<Direction> Directions(const RefineOptions& options) {
     }
   }
   return out;
+}
+
+// The options moving the place only (the width's search settles each trial's place).
+RefineOptions PlaceOnly(RefineOptions options) {
+  options.move_wrist = options.move_fingers = options.move_proportions = false;
+  options.move_place = true;
+  return options;
 }
 
 // The affine map of 2 x 3 matrices a after b.
@@ -82,8 +93,10 @@ bool RefineOptions::Check(std::string* why) const {
     *why = "the refinement's track bound must be within [0, 180] degrees";
   } else if (!(blur_px >= 0.0 && blur_px <= 8.0)) {
     *why = "the refinement's blur must be within [0, 8] crop pixels";
-  } else if (!move_place && !move_wrist && !move_fingers) {
-    *why = "the refinement must move something: the place, the wrist or the fingers";
+  } else if (!(width_step >= kWidthGrid && width_step <= 0.2)) {
+    *why = "the refinement's width step must be within [0.005, 0.2]";
+  } else if (!move_place && !move_wrist && !move_fingers && !move_proportions) {
+    *why = "the refinement must move something: the place, the wrist, the fingers or the proportions";
   } else if (render_side < 16 || render_side > 1024) {
     *why = "the refinement's render side must be within 16..1024 pixels";
   } else {
@@ -92,16 +105,22 @@ bool RefineOptions::Check(std::string* why) const {
   return false;
 }
 
+double WidthOnGrid(double width) {
+  return std::clamp(std::round(width / kWidthGrid) * kWidthGrid, kWidthMin, kWidthMax);
+}
+
 void SetRefineMoves(const std::vector<std::string>& names, RefineOptions* options) {
-  NPHAND_THROW_CHECK(!names.empty(), "the refinement must move something: name any of place, wrist and fingers");
+  NPHAND_THROW_CHECK(!names.empty(), "the refinement must move something: name any of place, wrist, fingers and proportions");
   RefineOptions moves = *options;
-  moves.move_place = moves.move_wrist = moves.move_fingers = false;
+  moves.move_place = moves.move_wrist = moves.move_fingers = moves.move_proportions = false;
   for (const std::string& name : names) {
-    bool* move = name == "place"     ? &moves.move_place
-                 : name == "wrist"   ? &moves.move_wrist
-                 : name == "fingers" ? &moves.move_fingers
-                                     : nullptr;
-    NPHAND_THROW_CHECK(move != nullptr, "unknown refinement move '", name, "' (choose any of place, wrist and fingers)");
+    bool* move = name == "place"         ? &moves.move_place
+                 : name == "wrist"       ? &moves.move_wrist
+                 : name == "fingers"     ? &moves.move_fingers
+                 : name == "proportions" ? &moves.move_proportions
+                                         : nullptr;
+    NPHAND_THROW_CHECK(move != nullptr, "unknown refinement move '", name,
+                       "' (choose any of place, wrist, fingers and proportions)");
     NPHAND_THROW_CHECK(!*move, "the refinement move '", name, "' is named twice");
     *move = true;
   }
@@ -113,6 +132,7 @@ std::vector<std::string> RefineMoves(const RefineOptions& options) {
   if (options.move_place) names.push_back("place");
   if (options.move_wrist) names.push_back("wrist");
   if (options.move_fingers) names.push_back("fingers");
+  if (options.move_proportions) names.push_back("proportions");
   return names;
 }
 
@@ -126,6 +146,8 @@ nlohmann::json ToJson(const RefineOptions& options) {
           {"move_place", options.move_place},
           {"move_wrist", options.move_wrist},
           {"move_fingers", options.move_fingers},
+          {"move_proportions", options.move_proportions},
+          {"width_step", options.width_step},
           {"prior", options.prior},
           {"track", options.track},
           {"track_within_deg", options.track_within_deg},
@@ -169,8 +191,24 @@ Refiner::Refiner(const HandModel& hand, const Intrinsics& camera, double distanc
   small_.cy *= shrink;
 }
 
-cv::Mat Refiner::Silhouette(const Scene& scene, const cv::Matx23d& crop_from_small, cv::Mat* object) {
-  renderer_.RenderLabels(scene, small_, &labels_);
+Refiner::Proportioned& Refiner::ProportionedOf(double width) {
+  const long key = std::lround(WidthOnGrid(width) / kWidthGrid);
+  auto it = proportioned_.find(key);
+  if (it == proportioned_.end()) {
+    Proportioned made;
+    made.model = std::make_unique<HandModel>(hand_model_.Reproportioned(1.0, key * kWidthGrid));
+    made.renderer = std::make_unique<Renderer>(*made.model);
+    it = proportioned_.emplace(key, std::move(made)).first;
+  }
+  return it->second;
+}
+
+const HandModel& Refiner::Model(double width) {
+  return WidthOnGrid(width) == 1.0 ? hand_model_ : *ProportionedOf(width).model;
+}
+
+cv::Mat Refiner::Silhouette(const Scene& scene, double width, const cv::Matx23d& crop_from_small, cv::Mat* object) {
+  (WidthOnGrid(width) == 1.0 ? renderer_ : *ProportionedOf(width).renderer).RenderLabels(scene, small_, &labels_);
   hand_.create(labels_.size(), CV_32FC2);
   for (int y = 0; y < labels_.rows; ++y) {
     const uint8_t* label = labels_.ptr<uint8_t>(y);
@@ -193,10 +231,11 @@ Eigen::Matrix3d RotationOf(const Refinement& refinement) {
 }
 
 Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv::Matx23d& start_crop_from_image,
-                           const Eigen::Matrix3d* previous) {
+                           const Eigen::Matrix3d* previous, double width, bool move_width) {
   NPHAND_THROW_CHECK(!target.image.empty() && target.image.type() == CV_32FC1 && target.image.rows == crop_.size &&
                          target.image.cols == crop_.size,
                      "refine: the target must be a ", crop_.size, " x ", crop_.size, " crop");
+  NPHAND_THROW_CHECK(std::isfinite(width), "refine: the hand's width factor must be finite");
   const std::vector<Direction> directions = Directions(options_);
   // Both silhouettes blurred alike, so that the render's pixel steps and the target's
   // resampling matter less than the shapes.
@@ -229,10 +268,11 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
   auto pose = [&](const Parameters& p) {
     scene.hand.camera_from_hand = wrist(p);
     for (int j = 0; j < kNumDofs; ++j) scene.hand.angles[j] = p[kWristAxes + j];
-    scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, hand_model_.bind_centre(), distance_m_);
+    scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, Model(p[kWidth]).bind_centre(), distance_m_);
   };
   Parameters origin{};
   for (int j = 0; j < kNumDofs; ++j) origin[kWristAxes + j] = start.hand.angles[j];
+  origin[kWidth] = WidthOnGrid(width);
   // The pull towards the start's pose (not its place): the mean square of the changes of
   // its angles (wrist and joints), over (90 degrees)².
   auto prior = [&](const Parameters& p) {
@@ -253,7 +293,7 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
     pose(p);
     ++out.renders;
     cv::Mat object;
-    cv::Mat hand = Silhouette(scene, Compose(crop_from_image(p), image_from_small), &object);
+    cv::Mat hand = Silhouette(scene, p[kWidth], Compose(crop_from_image(p), image_from_small), &object);
     if (options_.blur_px > 0.0) cv::GaussianBlur(hand, hand, cv::Size(), options_.blur_px);
     *disagreement = Disagreement(hand, goal, options_.object_unknown && !start.objects.empty() ? &object : nullptr);
     return *disagreement + prior(p) + pull(p);
@@ -263,39 +303,76 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
   double best_objective = evaluate(best, &best_disagreement);
   out.objective_before = best_objective;
   out.disagreement_before = best_disagreement;
+  // Steps along `direction` from `from` (into `from`, its objective and disagreement): a
+  // step each way, the first that improves taken and repeated while it still does;
+  // `settle_trial` (if given) moves each trial further before it is judged. True if it moved.
+  using Settle = std::function<double(Parameters*, double*)>;
+  auto step_along = [&](const Direction& direction, double step, Parameters* from, double* objective_of, double* disagreement_of,
+                        const Settle& settle_trial) {
+    for (double sign : {1.0, -1.0}) {
+      bool moved = false;
+      for (int repeat = 0; repeat < kRepeats; ++repeat) {
+        Parameters trial = *from;
+        for (const auto& [index, weight] : direction.moves) trial[index] += sign * weight * step;
+        JointAngles angles;
+        for (int j = 0; j < kNumDofs; ++j) angles[j] = trial[kWristAxes + j];
+        angles = ClampToLimits(angles);
+        for (int j = 0; j < kNumDofs; ++j) trial[kWristAxes + j] = angles[j];
+        trial[kWidth] = WidthOnGrid(trial[kWidth]);
+        if (trial == *from) break;
+        double disagreement = 0.0;
+        const double objective = settle_trial ? settle_trial(&trial, &disagreement) : evaluate(trial, &disagreement);
+        if (objective >= *objective_of) break;
+        *from = trial;
+        *objective_of = objective;
+        *disagreement_of = disagreement;
+        moved = true;
+      }
+      if (moved) return true;
+    }
+    return false;
+  };
+  auto step_of = [&](Kind kind, double scale) {
+    return scale * (kind == Kind::kWrist   ? options_.wrist_step_deg * kDegToRad
+                    : kind == Kind::kJoint ? options_.joint_step_deg * kDegToRad
+                    : kind == Kind::kShift ? options_.shift_step * crop_.size
+                    : kind == Kind::kScale ? options_.scale_step
+                                           : options_.wrist_step_deg * kDegToRad);
+  };
+  // With move_width, the hand's width is measured first, from the start's pose: each width's
+  // trial judged with its place settled, for a narrower hand is also a smaller silhouette
+  // (a width's step alone rarely agrees better, though the width with its place does). From
+  // the start's rotation, not the search's: the search's wrist turns to take up much of a
+  // width's narrowing. The search below keeps the width given.
+  double measured = origin[kWidth];
+  if (options_.move_proportions && move_width) {
+    const std::vector<Direction> place = Directions(PlaceOnly(options_));
+    const Settle settle = [&](Parameters* trial, double* disagreement) {
+      double objective = evaluate(*trial, disagreement);
+      for (int sweep = 0; sweep < kPlaceSweeps; ++sweep) {
+        bool improved = false;
+        for (const Direction& direction : place) {
+          improved |= step_along(direction, step_of(direction.kind, std::ldexp(0.5, -sweep)), trial, &objective, disagreement, nullptr);
+        }
+        if (!improved) break;
+      }
+      return objective;
+    };
+    Parameters at = origin;
+    double disagreement_at = 0.0;
+    double objective_at = settle(&at, &disagreement_at);
+    const Direction width{{{kWidth, 1.0}}, Kind::kWidth};
+    for (double step = options_.width_step; step >= kWidthGrid - 1e-12; step *= 0.5) {
+      step_along(width, step, &at, &objective_at, &disagreement_at, settle);
+    }
+    measured = at[kWidth];
+    out.width_disagreement = disagreement_at;
+  }
   for (int sweep = 0; sweep < options_.sweeps; ++sweep) {
     const double scale = std::ldexp(1.0, -std::min(sweep, options_.halvings));
     bool improved = false;
     for (const Direction& direction : directions) {
-      const double step = scale * (direction.kind == Kind::kWrist   ? options_.wrist_step_deg * kDegToRad
-                                   : direction.kind == Kind::kJoint ? options_.joint_step_deg * kDegToRad
-                                   : direction.kind == Kind::kShift ? options_.shift_step * crop_.size
-                                   : direction.kind == Kind::kScale ? options_.scale_step
-                                                                    : options_.wrist_step_deg * kDegToRad);
-      // A step each way; the first that improves is taken, and repeated while it still does.
-      for (double sign : {1.0, -1.0}) {
-        bool moved = false;
-        for (int repeat = 0; repeat < kRepeats; ++repeat) {
-          Parameters trial = best;
-          for (const auto& [index, weight] : direction.moves) trial[index] += sign * weight * step;
-          JointAngles angles;
-          for (int j = 0; j < kNumDofs; ++j) angles[j] = trial[kWristAxes + j];
-          angles = ClampToLimits(angles);
-          for (int j = 0; j < kNumDofs; ++j) trial[kWristAxes + j] = angles[j];
-          if (trial == best) break;
-          double disagreement = 0.0;
-          const double objective = evaluate(trial, &disagreement);
-          if (objective >= best_objective) break;
-          best = trial;
-          best_objective = objective;
-          best_disagreement = disagreement;
-          moved = true;
-        }
-        if (moved) {
-          improved = true;
-          break;
-        }
-      }
+      improved |= step_along(direction, step_of(direction.kind, scale), &best, &best_objective, &best_disagreement, nullptr);
     }
     if (!improved && scale <= std::ldexp(1.0, -options_.halvings)) break;
   }
@@ -306,6 +383,8 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
   out.scene = scene;
   out.crop_from_image = crop_from_image(best);
   out.turn = best[kPlace + 3];
+  out.width = best[kWidth];
+  out.width_measured = measured;
   return out;
 }
 

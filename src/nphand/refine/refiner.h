@@ -4,9 +4,12 @@
 // square window, turned by its principal axis), through the start's own crop map, so that
 // a finger's move does not rescale the silhouette. What moves: the silhouette's place in
 // the crop (shift, scale, turn within the view), the wrist across the view and, if asked,
-// the fingers' joints.
+// the fingers' joints. It can also measure the hand's proportions (its width against its
+// length: the crop hides the hand's size, so the silhouette tells their ratio only).
 #pragma once
 
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -32,6 +35,10 @@ struct RefineOptions {
   // The fingers' joints: off by default, for the silhouette does not tell them well enough
   // (the validation sweep, docs/estimator.md: joint error 2.2 -> 3.9 degrees on masks).
   bool move_fingers = false;
+  // The hand's width (across the palm and through it) against the database hand's at the
+  // same length, HandModel::Reproportioned(1, width): off unless asked (`proportions`).
+  bool move_proportions = false;
+  double width_step = 0.04;     // first step of the width's measurement (on a grid of kWidthGrid)
   // The pull towards the start: this weight times the sum of the squared changes of the
   // pose's angles (wrist and joints, radians) over their number (23), over (90 degrees)²,
   // added to the disagreement (1 - IoU).
@@ -51,8 +58,16 @@ struct RefineOptions {
 
 nlohmann::json ToJson(const RefineOptions& options);
 
-// What the search moves, by name: any of "place", "wrist" and "fingers" (`--refine-move`;
-// the default is place and wrist). Throws nphand::Error naming an unknown or repeated name,
+// The width factors the refinement searches: multiples of kWidthGrid within [kWidthMin,
+// kWidthMax] (a hand 10 % longer and narrower than the database's is 0.82).
+inline constexpr double kWidthGrid = 0.005;
+inline constexpr double kWidthMin = 0.7;
+inline constexpr double kWidthMax = 1.4;
+// `width` clamped to [kWidthMin, kWidthMax] and rounded to the grid.
+double WidthOnGrid(double width);
+
+// What the search moves, by name: any of "place", "wrist", "fingers" and "proportions"
+// (`--refine-move`; the default is place and wrist). Throws nphand::Error naming an unknown or repeated name,
 // or for none.
 void SetRefineMoves(const std::vector<std::string>& names, RefineOptions* options);
 std::vector<std::string> RefineMoves(const RefineOptions& options);
@@ -71,6 +86,9 @@ struct Refinement {
   double objective_after = 0.0;      // and at the end (never above the start's)
   double disagreement_before = 0.0;  // 1 - IoU at the start
   double disagreement_after = 0.0;
+  double width = 1.0;                // the hand's width factor the search used (the one given, on the grid)
+  double width_measured = 1.0;       // with move_proportions and move_width: the width the silhouette favours
+  double width_disagreement = 1.0;   // and 1 - IoU there (from the start's pose, its place settled)
   int renders = 0;
   bool moved = false;                // the pose or place changed
 };
@@ -96,15 +114,28 @@ class Refiner {
   // target of another size.
   // `previous` (if not null) is the previous frame's refined rotation as this start's would
   // be reported: RotationOf(previous refinement), turned into this start's image plane.
+  // The hand is `width` times as wide as the database's (on the grid: WidthOnGrid); with
+  // move_proportions and `move_width` the width the silhouette favours is measured too
+  // (from the start's pose, its place settled; Refinement::width_measured), the search
+  // keeping the width given.
   Refinement Refine(const HandCrop& target, const Scene& start, const cv::Matx23d& start_crop_from_image,
-                    const Eigen::Matrix3d* previous = nullptr);
+                    const Eigen::Matrix3d* previous = nullptr, double width = 1.0, bool move_width = true);
 
   const RefineOptions& options() const { return options_; }
+  // The hand `width` times as wide as the database's (the one given at construction for 1;
+  // the others made when first asked for and kept while the refiner lives).
+  const HandModel& Model(double width);
 
  private:
-  // The coverage of `scene`'s hand in the crop, rendered at the search's resolution and
-  // warped by `crop_from_small`; `object` gets its object's.
-  cv::Mat Silhouette(const Scene& scene, const cv::Matx23d& crop_from_small, cv::Mat* object);
+  // The coverage of `scene`'s hand (`width` times as wide as the database's) in the crop,
+  // rendered at the search's resolution and warped by `crop_from_small`; `object` gets its
+  // object's.
+  cv::Mat Silhouette(const Scene& scene, double width, const cv::Matx23d& crop_from_small, cv::Mat* object);
+  struct Proportioned {
+    std::unique_ptr<HandModel> model;
+    std::unique_ptr<Renderer> renderer;
+  };
+  Proportioned& ProportionedOf(double width);
 
   const HandModel& hand_model_;
   Intrinsics camera_;
@@ -113,6 +144,7 @@ class Refiner {
   CropOptions crop_;
   RefineOptions options_;
   Renderer renderer_;
+  std::map<long, Proportioned> proportioned_;  // by width in grid steps, other than 1
   cv::Mat labels_, hand_;  // the search's buffers
 };
 
