@@ -321,19 +321,33 @@ PYBIND11_MODULE(nphand, m) {
       .def_property_readonly("box", [](const FrameResult& r) { return py::make_tuple(r.box.x, r.box.y, r.box.width, r.box.height); })
       .def_readonly("depth_m", &FrameResult::depth_m)
       .def_readonly("confidence", &FrameResult::confidence)
+      .def_readonly("refined", &FrameResult::refined, "with refine: whether the refinement moved the pose")
+      .def_property_readonly(
+          "proportions",
+          [](const FrameResult& r) -> py::object {
+            if (!r.proportions.has_value()) return py::none();
+            py::dict d;
+            d["length"] = r.proportions->length;
+            d["width"] = r.proportions->width;
+            d["held"] = r.proportions->held;
+            return d;
+          },
+          "with refine_move holding \"proportions\": {length, width, held}, the hand's as factors of the database "
+          "hand's; else None")
       .def_readonly("grasps", &FrameResult::grasps)
       .def_readonly("objects", &FrameResult::objects)
       .def_property_readonly("ms", [](const FrameResult& r) { return r.ms.total; }, "the estimator's time on the frame");
 
   py::class_<Estimate>(m, "Estimator", "Hand poses frame by frame, with the temporal prior over a video")
       .def(py::init([](std::shared_ptr<Database> db, std::shared_ptr<KnnIndex> index, std::shared_ptr<HandModel> hand,
-                       const std::string& side, int k, int track_views, bool refine, bool smooth, double hand_length, double fov,
-                       double focal, bool faces) {
+                       const std::string& side, int k, int track_views, bool refine, const std::vector<std::string>& refine_move,
+                       bool smooth, double hand_length, double fov, double focal, bool faces) {
              EstimatorOptions options;
              SetHandChoice(side, &options);
              options.k = k;
              options.track_views = track_views;
              options.refine = refine;
+             SetRefineMoves(refine_move, &options.refinement);
              options.smooth = smooth;
              options.hand_length_m = hand_length;
              options.fov_deg = fov;
@@ -344,7 +358,8 @@ PYBIND11_MODULE(nphand, m) {
              return std::make_unique<Estimate>(std::move(db), std::move(index), std::move(hand), options);
            }),
            py::arg("db"), py::arg("index"), py::arg("hand_model"), py::arg("hand") = "right", py::arg("k") = 500,
-           py::arg("track_views") = EstimatorOptions{}.track_views, py::arg("refine") = false, py::arg("smooth") = true,
+           py::arg("track_views") = EstimatorOptions{}.track_views, py::arg("refine") = false,
+           py::arg("refine_move") = RefineMoves(RefineOptions{}), py::arg("smooth") = true,
            py::arg("hand_length") = 0.18, py::arg("fov") = 60.0,
            py::arg("focal") = 0.0, py::arg("faces") = true)
       .def("process", &Estimate::Process, py::arg("frame"), py::arg("time_s") = py::none(), py::arg("roi") = py::none(),

@@ -74,6 +74,23 @@ def test_smoothing_is_on_by_default_and_can_be_turned_off(hand, tiny, frames):
     assert max(steps[1:]) > 1e-6
 
 
+def test_the_refinement_says_what_it_did_and_measures_proportions_when_asked(hand, tiny, frames):
+    db, index = tiny
+    plain = nphand.Estimator(db, index, hand, k=40, faces=False)
+    refined = nphand.Estimator(db, index, hand, k=40, faces=False, refine=True,
+                               refine_move=["place", "wrist", "proportions"])
+    for frame in frames:
+        a = plain.process(frame["rgb"], frame["time_s"])
+        b = refined.process(frame["rgb"], frame["time_s"])
+        assert a.detected and b.detected
+        assert a.proportions is None and not a.refined
+        assert set(b.proportions) == {"length", "width", "held"}
+        # Until the width is held the hand is the database's.
+        assert b.proportions["held"] or b.proportions["width"] == b.proportions["length"]
+    with pytest.raises(nphand.Error, match="unknown refinement move 'thumb'"):
+        nphand.Estimator(db, index, hand, refine=True, refine_move=["thumb"])
+
+
 def test_errors_are_exceptions_with_the_clis_message(tmp_path):
     bad = tmp_path / "bad.db"
     bad.write_bytes(b"garbage")

@@ -803,7 +803,11 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
     Refinement r;
     double from_last;  // degrees from the last frame's refined rotation (0 without one)
   };
-  const bool move_width = options_.refinement.move_proportions && !width_held_;
+  // The width is measured on the side the track holds (with hand_auto both are refined)
+  // until it is held; `width_was_held`: this frame's hand is of the held width.
+  const bool width_was_held = width_held_;
+  const bool move_width =
+      options_.refinement.move_proportions && !width_held_ && (!options_.hand_auto || result->hand == side_);
   auto attempt = [&](const Candidate& c) {
     const cv::Matx23d start_map = PlacementOf(c.entry).crop_from_image;
     // The track's last rotation in this entry's image plane.
@@ -846,7 +850,7 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
       }
     }
     const double length = options_.hand_length_m / model_hand_length_;
-    result->proportions = FrameResult::Proportions{length, length * r.width, !move_width};
+    result->proportions = FrameResult::Proportions{length, length * r.width, width_was_held};
   }
   std::optional<EntryPlacement> refined;
   if (result->refined || r.width != 1.0) {
