@@ -129,6 +129,8 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   estimator_options.max_distance = options.max_distance;
   estimator_options.k = options.k;
   estimator_options.track_views = options.track_views;
+  estimator_options.carried = options.carried;
+  estimator_options.carry_apart_frames = options.carry_apart_frames;
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, index, hand, estimator_options);
@@ -149,6 +151,8 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["max_distance"] = options.max_distance;
   result.figures["k"] = options.k;
   result.figures["track_views"] = options.track_views;
+  result.figures["carried"] = options.carried;
+  result.figures["carry_apart_frames"] = options.carry_apart_frames;
   result.figures["given_box"] = options.given_box;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {

@@ -85,6 +85,8 @@ struct EvalRealCommandOptions : EstimatorFiles {
   double max_distance = EstimatorOptions{}.max_distance;  // "no hand" beyond this feature distance
   int k = EstimatorOptions{}.k;            // neighbours searched
   int track_views = EstimatorOptions{}.track_views;  // viewpoints of the track's views searched besides
+  int carried = EstimatorOptions{}.carried;          // hypotheses carried to the next frame
+  int carry_apart_frames = EstimatorOptions{}.carry_apart_frames;  // a track's first frames carry one hypothesis per mode
   // The hand's place given: each labelled hand estimated within its found region (the
   // pose alone judged, apart from finding the hand).
   bool given_box = false;

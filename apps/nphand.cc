@@ -178,6 +178,10 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--sigma-x", e.sigma_x, "Prior kernel width, pose-vector units")->capture_default_str();
   cmd->add_option("--prior-share", e.prior_share, "The weighted sum's share of the prior")->capture_default_str();
   cmd->add_option("--carried", e.carried, "Hypotheses carried to the next frame")->capture_default_str();
+  cmd->add_option("--carry-apart", e.carry_apart_frames,
+                  "In a track's first N frames, carry hypotheses at least --sigma-x apart in pose (one per mode; 0: never)")
+      ->check(WholeNumber())
+      ->capture_default_str();
   cmd->add_option("--top-n", e.top_n, "Hypotheses kept per frame")->capture_default_str();
   cmd->add_flag("--top", o.top, "Write the top-N hypotheses in each line");
   cmd->add_option("--max-distance", e.max_distance, "No hand when the nearest view is farther than this")->capture_default_str();
@@ -442,6 +446,11 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_option("--k", o.k, "Neighbours searched per frame")->capture_default_str();
   cmd->add_option("--track-views", o.track_views,
                   "In a track, also measure the entries of this many viewpoints nearest the last best view's (0: none)")
+      ->capture_default_str();
+  cmd->add_option("--carried", o.carried, "Hypotheses carried to the next frame")->capture_default_str();
+  cmd->add_option("--carry-apart", o.carry_apart_frames,
+                  "In a track's first N frames, carry hypotheses at least sigma_x apart in pose (one per mode; 0: never)")
+      ->check(WholeNumber())
       ->capture_default_str();
   cmd->add_flag("--given-box", o.given_box,
                 "The hand's place given: each labelled hand estimated within its box grown by 25 % (its pose judged alone)");

@@ -286,6 +286,25 @@ TEST_F(EstimatorTest, AHandTheForearmCutWouldMaimIsJudgedWhole) {
   EXPECT_EQ(tried, 3) << "hands the cut maims";
 }
 
+// Carried one per mode: the best of a second mode is kept where the first mode's runners-up
+// would have filled every place.
+TEST(CarriedOrderTest, ApartTheBestOfEachModeIsCarried) {
+  PoseX a = PoseX::Zero(), b = PoseX::Zero();
+  b[9] = 2.0;
+  std::vector<PoseX> poses;
+  for (int i = 0; i < 4; ++i) {
+    PoseX p = a;
+    p[10] = 0.05 * i;  // four hypotheses in mode a, by descending weight
+    poses.push_back(p);
+  }
+  poses.push_back(b);  // then mode b's best
+  const std::vector<size_t> order = {0, 1, 2, 3, 4};
+  EXPECT_EQ(CarriedOrder(poses, order, 3, 0.0), (std::vector<size_t>{0, 1, 2}));
+  EXPECT_EQ(CarriedOrder(poses, order, 3, 0.5), (std::vector<size_t>{0, 4}));
+  EXPECT_EQ(CarriedOrder(poses, order, 1, 0.5), (std::vector<size_t>{0}));
+  EXPECT_EQ(CarriedOrder(poses, {}, 3, 0.5), (std::vector<size_t>{}));
+}
+
 TEST(CombineWithPriorTest, WeightsAreNormalisedAndTwoModesSurviveUntilTheObservationSeparatesThem) {
   PoseX a = PoseX::Zero(), b = PoseX::Zero();
   b[9] = 2.0;  // far apart in pose space
@@ -734,6 +753,9 @@ TEST_F(EstimatorTest, BadSetUpsAreRefused) {
   options = Options();
   options.track_views = 65;
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "track's views must be within 0..64");
+  options = Options();
+  options.carry_apart_frames = -1;
+  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "carrying hypotheses apart");
   options = Options();
   options.min_hand_px = 0;
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "smallest hand");

@@ -44,6 +44,8 @@ TEST_F(EstimatorStudyTest, EverySettingIsNamedOnceAndVariesWhatItSays) {
   EXPECT_EQ(find("track-views0").options.track_views, 0);
   EXPECT_EQ(find("track-views8").options.track_views, 8);
   EXPECT_EQ(find("carried20").options.carried, 20);
+  EXPECT_EQ(find("carry-apart30").options.carry_apart_frames, 30);
+  EXPECT_EQ(EstimatorOptions{}.carry_apart_frames, 0);
   EXPECT_FALSE(find("nn").options.refine);
   EXPECT_TRUE(find("refine").options.refine);
   EXPECT_FALSE(find("refine").options.refinement.move_fingers);

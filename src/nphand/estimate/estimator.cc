@@ -144,6 +144,18 @@ std::vector<double> CombineWithPrior(const std::vector<PoseX>& poses, const std:
   return w;
 }
 
+std::vector<size_t> CarriedOrder(const std::vector<PoseX>& poses, const std::vector<size_t>& order, int count, double apart) {
+  std::vector<size_t> carried;
+  for (size_t i : order) {
+    if (static_cast<int>(carried.size()) >= count) break;
+    if (apart > 0.0 && std::any_of(carried.begin(), carried.end(), [&](size_t c) { return (poses[c] - poses[i]).norm() < apart; })) {
+      continue;
+    }
+    carried.push_back(i);
+  }
+  return carried;
+}
+
 std::string ToString(FrameStatus status) {
   switch (status) {
     case FrameStatus::kDetected: return "detected";
@@ -162,6 +174,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the prior's share must be within [0, 1]";
   } else if (track_views < 0 || track_views > 64) {
     *why = "the track's views must be within 0..64";
+  } else if (carry_apart_frames < 0) {
+    *why = "the frames carrying hypotheses apart must be 0 or more";
   } else if (carried < 1 || carried > k || top_n < 1 || top_n > k) {
     *why = "carried hypotheses and top-N must be within 1..k";
   } else if (!(roll_ambiguity >= 0.0 && roll_ambiguity < 10.0) || !(max_distance > 0.0 && max_distance < 10.0)) {
@@ -306,6 +320,7 @@ void Estimator::Reset() {
   side_frame_ = -1;
   refined_ = {};
   refined_before_ = {};
+  track_start_ = {0, 0};
   widths_.clear();
   width_ = 1.0;
   width_held_ = false;
@@ -732,12 +747,15 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return hyp[a].w > hyp[b].w; });
   const Candidate& best = hyp[order[0]];
 
-  // Carry the best to the next frame.
+  // Carry the best to the next frame (in a track's first frames, the best of each mode).
+  const size_t side = result->hand == Handedness::kRight ? 0 : 1;
+  if (!result->prior_used) track_start_[side] = result->frame;
+  const bool apart = result->frame - track_start_[side] < options_.carry_apart_frames;
   carried_.clear();
   double carried_sum = 0.0;
-  for (size_t r = 0; r < order.size() && static_cast<int>(r) < options_.carried; ++r) {
-    carried_.push_back({hyp[order[r]].x, hyp[order[r]].w, hyp[order[r]].entry});
-    carried_sum += hyp[order[r]].w;
+  for (size_t i : CarriedOrder(poses, order, options_.carried, apart ? options_.sigma_x : 0.0)) {
+    carried_.push_back({hyp[i].x, hyp[i].w, hyp[i].entry});
+    carried_sum += hyp[i].w;
   }
   for (WeightedPose& c : carried_) c.weight = carried_sum > 0.0 ? c.weight / carried_sum : 1.0 / carried_.size();
 

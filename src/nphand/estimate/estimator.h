@@ -56,6 +56,11 @@ struct EstimatorOptions {
   double sigma_x = 0.5;                         // the prior's kernel width in pose-vector units
   double prior_share = 0.9;                     // kSum's weight on the prior
   int carried = 5;                              // hypotheses carried to the next frame
+  // In the first carry_apart_frames frames of a track the carried hypotheses lie at least
+  // sigma_x apart in pose (the best of each mode), so that a second mode survives while the
+  // first holds the estimate, where the lookup's first pick may lock a wrong one in
+  // (0: never; docs/estimator.md).
+  int carry_apart_frames = 0;
   // The track's views: in a track, the entries seen from the `track_views` viewpoints
   // nearest the last frame's best (its own first) join the K neighbours, measured against the
   // frame's descriptor, so that the prior finds the views near its track even where an
@@ -200,6 +205,11 @@ struct WeightedPose {
 // (prior, sigma_x, prior_share); normalised. Without a prior, or when the prior gives every
 // hypothesis nothing (the hand jumped), the observation weights come back and
 // `*prior_used` is false.
+// Which hypotheses are carried to the next frame: the first `count` of `order` (indices
+// into `poses` by descending weight), or with `apart` > 0 the first `count` that lie at
+// least `apart` from every one taken before them.
+std::vector<size_t> CarriedOrder(const std::vector<PoseX>& poses, const std::vector<size_t>& order, int count, double apart);
+
 std::vector<double> CombineWithPrior(const std::vector<PoseX>& poses, const std::vector<double>& observation,
                                      const std::vector<WeightedPose>& carried, const EstimatorOptions& options,
                                      bool* prior_used);
@@ -333,6 +343,7 @@ class Estimator {
   static constexpr double kWidthSpread = 0.03;
   static constexpr double kWidthFit = 0.15;
   std::vector<WeightedPose> carried_;
+  std::array<int, 2> track_start_ = {0, 0};  // by side: the frame the track began (its first frame without the prior)
   // track_views: by viewpoint, the entries the index holds and the track_views nearest
   // viewpoints (itself first); per entry, the search that last found it.
   std::vector<std::vector<entry_id_t>> view_entries_;

@@ -54,6 +54,10 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     change(e);
     out.push_back({name, e});
   };
+  // The carried hypotheses one per mode in a track's first frames (all its frames: 100000).
+  for (int frames : {10, 30, 100000}) {
+    around_default("carry-apart" + std::to_string(frames), [&](EstimatorOptions& e) { e.carry_apart_frames = frames; });
+  }
   for (int carried : {20, 100}) {
     around_default("carried" + std::to_string(carried), [&](EstimatorOptions& e) { e.carried = carried; });
   }
@@ -213,7 +217,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     score.name = setting.name;
     score.options = {{"k", e.k},           {"observation", ToString(e.observation)}, {"sigma_y", e.sigma_y},
                      {"prior", ToString(e.prior)}, {"sigma_x", e.sigma_x}, {"prior_share", e.prior_share},
-                     {"carried", e.carried},        {"roll_ambiguity", e.roll_ambiguity},
+                     {"carried", e.carried},        {"carry_apart_frames", e.carry_apart_frames}, {"roll_ambiguity", e.roll_ambiguity},
                      {"refine", RefinementJson(e)},
                      {"smooth", SmoothingJson(e)}};
     std::vector<double> ms;
