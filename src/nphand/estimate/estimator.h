@@ -200,16 +200,16 @@ struct WeightedPose {
   std::optional<uint32_t> entry;  // the database entry it is (none: a pose from elsewhere)
 };
 
-// The temporal step: hypotheses' observation weights (normalised) combined with the kernel
-// density over the previous frame's weighted hypotheses `carried`, as `options` says
-// (prior, sigma_x, prior_share); normalised. Without a prior, or when the prior gives every
-// hypothesis nothing (the hand jumped), the observation weights come back and
-// `*prior_used` is false.
 // Which hypotheses are carried to the next frame: the first `count` of `order` (indices
 // into `poses` by descending weight), or with `apart` > 0 the first `count` that lie at
 // least `apart` from every one taken before them.
 std::vector<size_t> CarriedOrder(const std::vector<PoseX>& poses, const std::vector<size_t>& order, int count, double apart);
 
+// The temporal step: hypotheses' observation weights (normalised) combined with the kernel
+// density over the previous frame's weighted hypotheses `carried`, as `options` says
+// (prior, sigma_x, prior_share); normalised. Without a prior, or when the prior gives every
+// hypothesis nothing (the hand jumped), the observation weights come back and
+// `*prior_used` is false.
 std::vector<double> CombineWithPrior(const std::vector<PoseX>& poses, const std::vector<double>& observation,
                                      const std::vector<WeightedPose>& carried, const EstimatorOptions& options,
                                      bool* prior_used);

@@ -67,8 +67,8 @@ inline constexpr double kWidthMax = 1.4;
 double WidthOnGrid(double width);
 
 // What the search moves, by name: any of "place", "wrist", "fingers" and "proportions"
-// (`--refine-move`; the default is place and wrist). Throws nphand::Error naming an unknown or repeated name,
-// or for none.
+// (`--refine-move`; the default is place and wrist). Throws nphand::Error naming an unknown
+// or repeated name, or for none.
 void SetRefineMoves(const std::vector<std::string>& names, RefineOptions* options);
 std::vector<std::string> RefineMoves(const RefineOptions& options);
 
