@@ -14,16 +14,10 @@
 #include "nphand/segment/regions.h"
 #include "nphand/util/check.h"
 #include "nphand/util/parallel.h"
+#include "nphand/util/stats.h"
 
 namespace nphand {
 namespace {
-
-// The median of `values` (the mean of the middle two for an even count); none empty.
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
 
 using Clock = std::chrono::steady_clock;
 
@@ -322,8 +316,7 @@ void Estimator::Reset() {
   refined_before_ = {};
   track_start_ = {0, 0};
   widths_.clear();
-  width_ = 1.0;
-  width_held_ = false;
+  held_width_.reset();
   ResetSmoothing();
   smoothed_side_ = options_.hand;
 }
@@ -823,16 +816,16 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
   };
   // The width is measured on the side the track holds (with hand_auto both are refined)
   // until it is held; `width_was_held`: this frame's hand is of the held width.
-  const bool width_was_held = width_held_;
+  const bool width_was_held = held_width_.has_value();
   const bool move_width =
-      options_.refinement.move_proportions && !width_held_ && (!options_.hand_auto || result->hand == side_);
+      options_.refinement.move_proportions && !width_was_held && (!options_.hand_auto || result->hand == side_);
   auto attempt = [&](const Candidate& c) {
     const cv::Matx23d start_map = PlacementOf(c.entry).crop_from_image;
     // The track's last rotation in this entry's image plane.
     const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -c.turn) * before;
     Tried tried{&c,
-                refiner_->Refine(lookup.crops[c.turn_of], EntryScene(c.entry), start_map, track ? &previous : nullptr, width_,
-                                 move_width),
+                refiner_->Refine(lookup.crops[c.turn_of], EntryScene(c.entry), start_map, track ? &previous : nullptr,
+                                 held_width_.value_or(1.0), move_width),
                 0.0};
     if (last) tried.from_last = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), c.turn) * RotationOf(tried.r), before);
     return tried;
@@ -861,10 +854,7 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
       if (widths_.size() >= kWidthFrames) {
         std::vector<double> last(widths_.end() - kWidthFrames, widths_.end());
         std::sort(last.begin(), last.end());
-        if (last[3 * kWidthFrames / 4] - last[kWidthFrames / 4] <= kWidthSpread) {
-          width_held_ = true;
-          width_ = WidthOnGrid(Median(widths_));
-        }
+        if (last[3 * kWidthFrames / 4] - last[kWidthFrames / 4] <= kWidthSpread) held_width_ = WidthOnGrid(*TrueMedian(widths_));
       }
     }
     const double length = options_.hand_length_m / model_hand_length_;

@@ -333,12 +333,11 @@ class Estimator {
   std::array<Refined, 2> refined_;         // by side (right, left): the latest
   std::array<Refined, 2> refined_before_;  // by side: the latest of an earlier frame than refined_'s
   // With the proportions measured: the video's frames' widths (against the length) where
-  // the silhouette at the width measured agreed within kWidthFit, and the width used: the
-  // database's (1) until the last kWidthFrames measurements' middle half spans at most
-  // kWidthSpread, then their whole median, held (no longer measured).
+  // the silhouette at the width measured agreed within kWidthFit, and the width held once
+  // the last kWidthFrames measurements' middle half spans at most kWidthSpread: their whole
+  // median, no longer measured (until then the hand is the database's, width 1).
   std::vector<double> widths_;
-  double width_ = 1.0;
-  bool width_held_ = false;
+  std::optional<double> held_width_;
   static constexpr size_t kWidthFrames = 10;
   static constexpr double kWidthSpread = 0.03;
   static constexpr double kWidthFit = 0.15;

@@ -12,6 +12,7 @@
 #include "nphand/eval/json_lines.h"
 #include "nphand/eval/measures.h"
 #include "nphand/util/check.h"
+#include "nphand/util/stats.h"
 #include "nphand/util/text.h"
 
 namespace nphand {
@@ -139,14 +140,6 @@ std::array<bool, 4> FingerStates(const Keypoints3d& k) {
 std::optional<double> MeanOf(const std::vector<double>& values) {
   if (values.empty()) return std::nullopt;
   return std::accumulate(values.begin(), values.end(), 0.0) / values.size();
-}
-
-// The median as Python's statistics.median: the mean of the two middle values of an even count.
-std::optional<double> TrueMedian(std::vector<double> values) {
-  if (values.empty()) return std::nullopt;
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 == 1 ? values[n / 2] : (values[n / 2 - 1] + values[n / 2]) / 2.0;
 }
 
 RealAggregate Aggregate(const std::vector<const RealHandScore*>& rows, int extra, int images) {

@@ -318,7 +318,7 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
         for (int j = 0; j < kNumDofs; ++j) angles[j] = trial[kWristAxes + j];
         angles = ClampToLimits(angles);
         for (int j = 0; j < kNumDofs; ++j) trial[kWristAxes + j] = angles[j];
-        trial[kWidth] = WidthOnGrid(trial[kWidth]);
+        if (direction.kind == Kind::kWidth) trial[kWidth] = WidthOnGrid(trial[kWidth]);
         if (trial == *from) break;
         double disagreement = 0.0;
         const double objective = settle_trial ? settle_trial(&trial, &disagreement) : evaluate(trial, &disagreement);
