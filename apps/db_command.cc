@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "nphand/features/crop.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
 
@@ -30,6 +31,14 @@ std::pair<int, int> ParseShard(const std::string& text) {
 }  // namespace
 
 nlohmann::json RunDbBuild(DbBuildCommandOptions options) {
+  if (!options.gestures.empty()) options.build.gestures.clear();
+  for (const std::string& name : options.gestures) {
+    if (name == "all") {
+      options.build.gestures = GestureIds();
+    } else if (name != "none") {
+      options.build.gestures.push_back(GestureByName(name).id);
+    }
+  }
   if (!options.shard.empty()) {
     std::tie(options.build.shard_index, options.build.shard_count) = ParseShard(options.shard);
   }

@@ -14,6 +14,7 @@ namespace nphand {
 struct DbBuildCommandOptions {
   std::filesystem::path out = "out/nphand.db";
   DatabaseBuildOptions build;
+  std::vector<std::string> gestures;  // gesture names, "all" or "none": replace build.gestures when given
   std::string shard;  // "i/N" or empty
   std::filesystem::path asset_dir = DefaultAssetDir();
   bool quiet = false;  // no progress line

@@ -70,7 +70,11 @@ void AddRenderCommand(CLI::App& app, nphand::RenderCommandOptions& o) {
   cmd->add_option("--grasp", o.grasp,
                   "A grasp of the GRASP taxonomy (e.g. large_diameter; replaces --pose and --object), "
                   "or 'all' for a contact sheet of the 33");
-  cmd->add_option("--step", o.step, "The grasp's time step, 0 (pre-shape) to 4 (grasp)")->capture_default_str();
+  cmd->add_option("--gesture", o.gesture,
+                  "A gesture held without an object (e.g. peace; replaces --pose and --object), or 'all' for a "
+                  "contact sheet of them");
+  cmd->add_option("--step", o.step, "The grasp's (or gesture's) time step, 0 (pre-shape) to 4 (grasp)")
+      ->capture_default_str();
   cmd->add_option("--angle", o.angles, "Override a joint angle, NAME=DEGREES (e.g. index_pip_flex=45); repeatable");
   cmd->add_option("--azimuth", o.azimuth_deg, "Viewpoint azimuth, degrees (0: palm, 180: back)")->capture_default_str();
   cmd->add_option("--elevation", o.elevation_deg, "Viewpoint elevation, degrees")->capture_default_str();
@@ -270,6 +274,10 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
   CLI::App* build = db->add_subcommand("build", "Render every grasp, step, object/no object and viewpoint into a database");
   build->add_option("--out", a.build.out, "Database file to write")->capture_default_str();
   AddGraspCheck(build->add_option("--grasps", b.grasps, "Taxonomy numbers to include (default: all 33)")->delimiter(','));
+  build->add_option("--gestures", a.build.gestures,
+                    "Gestures held without an object to include besides the grasps: all (the default), none, or "
+                    "names (e.g. fist,peace)")
+      ->delimiter(',');
   build->add_option("--directions", b.directions, "Viewing directions on the sphere")->capture_default_str();
   build->add_option("--image-size", b.image_size, "Rendered image side, pixels")->capture_default_str();
   build->add_option("--threads", b.threads, "Worker threads (0: all cores)")->capture_default_str();

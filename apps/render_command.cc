@@ -10,6 +10,7 @@
 
 #include "nphand/render/draw.h"
 #include "nphand/render/renderer.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
@@ -67,6 +68,10 @@ bool RenderCommandOptions::Check(std::string* why) const {
     *why = "--object-at and --object-rotate take three values";
     return false;
   }
+  if (!grasp.empty() && !gesture.empty()) {
+    *why = "--grasp and --gesture exclude each other";
+    return false;
+  }
   if (step < 0 || step >= kGraspSteps) {
     *why = "--step must be between 0 and " + std::to_string(kGraspSteps - 1);
     return false;
@@ -89,6 +94,8 @@ Scene SceneOf(const RenderCommandOptions& options, const HandModel& model, const
     const Grasp grasp = MakeGrasp(model, GraspByName(options.grasp));
     scene.hand.angles = grasp.steps[options.step];
     scene.objects = {grasp.object};
+  } else if (!options.gesture.empty()) {
+    scene.hand.angles = GestureSteps(GestureByName(options.gesture))[options.step];
   } else {
     scene.hand.angles = ArticulationOf(options);
     if (!options.object.empty()) {
@@ -109,23 +116,26 @@ Scene SceneOf(const RenderCommandOptions& options, const HandModel& model, const
   return scene;
 }
 
-// All 33 grasps, one tile each, named, in the taxonomy's order.
-RenderCommandResult RunGraspSheet(const RenderCommandOptions& options, const HandModel& model, const Viewpoint& view) {
-  const int tile = 256, columns = 6, rows = (kNumGrasps + columns - 1) / columns;
+// All 33 grasps (or all gestures), one tile each, named and numbered, in their order.
+RenderCommandResult RunSheet(const RenderCommandOptions& options, const HandModel& model, const Viewpoint& view,
+                             bool gestures) {
+  const int count = gestures ? kNumGestures : kNumGrasps;
+  const int tile = 256, columns = 6, rows = (count + columns - 1) / columns;
   cv::Mat sheet(rows * tile, columns * tile, CV_8UC3, cv::Scalar(40, 40, 40));
   const Intrinsics intrinsics = Intrinsics::FromFieldOfView(tile, tile, options.fov_deg * kRadPerDeg);
   Renderer renderer(model);
   RenderCommandOptions one = options;
-  for (int i = 0; i < kNumGrasps; ++i) {
-    one.grasp = GraspTaxonomy()[i].name;
+  for (int i = 0; i < count; ++i) {
+    const int shape = gestures ? kFirstGestureId + i : i + 1;
+    (gestures ? one.gesture : one.grasp) = HandShapeKey(shape);
     const RenderedImages images = renderer.Render(SceneOf(one, model, view), intrinsics);
     cv::Mat cell = sheet(cv::Rect((i % columns) * tile, (i / columns) * tile, tile, tile));
     images.rgb.copyTo(cell);
-    cv::putText(cell, std::to_string(i + 1) + " " + GraspTaxonomy()[i].name, {6, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+    cv::putText(cell, std::to_string(shape) + " " + HandShapeKey(shape), {6, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
                 cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   }
-  const std::filesystem::path path =
-      options.out_dir / (options.name + "_grasps_step" + std::to_string(options.step) + ".png");
+  const std::filesystem::path path = options.out_dir / (options.name + (gestures ? "_gestures" : "_grasps") + "_step" +
+                                                        std::to_string(options.step) + ".png");
   WriteImageAtomic(path, sheet);
   RenderCommandResult result;
   result.files.push_back(path);
@@ -142,7 +152,9 @@ RenderCommandResult RunRender(const RenderCommandOptions& options) {
   CheckOutputsApart({{options.background, "--background"}}, {{options.out_dir, "render --out", {".png"}}});
   const HandModel model = HandModel::Load(HandednessFromString(options.hand), options.asset_dir);
   const Viewpoint view{options.azimuth_deg * kRadPerDeg, options.elevation_deg * kRadPerDeg, options.roll_deg * kRadPerDeg};
-  if (options.grasp == "all") return RunGraspSheet(options, model, view);
+  if (options.grasp == "all" || options.gesture == "all") {
+    return RunSheet(options, model, view, options.gesture == "all");
+  }
   const Scene scene = SceneOf(options, model, view);
 
   RenderOptions render_options;

@@ -15,6 +15,7 @@ struct RenderCommandOptions {
   std::string hand = "right";            // right | left
   std::string pose = "relaxed";          // a named articulation (NamedArticulations())
   std::string grasp;                     // a grasp of the taxonomy ("large_diameter"), or "all"
+  std::string gesture;                   // or a gesture ("peace"), or "all"
                                          // for a contact sheet; replaces pose and object
   int step = kGraspSteps - 1;            // which of the grasp's time steps (0: pre-shape)
   std::vector<std::string> angles;       // overrides "index_pip_flex=45" (degrees)

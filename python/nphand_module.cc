@@ -26,6 +26,7 @@
 #include "nphand/model/hand_model.h"
 #include "nphand/render/draw.h"
 #include "nphand/render/renderer.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/scene/grasp.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/sequence/sequence.h"
@@ -260,19 +261,29 @@ PYBIND11_MODULE(nphand, m) {
 
   m.def(
       "build_database",
-      [](const HandModel& hand, const std::filesystem::path& path, std::vector<int> grasps, int directions,
-         int image_size, int threads) {
+      [](const HandModel& hand, const std::filesystem::path& path, std::vector<int> grasps,
+         const std::vector<std::string>& gestures, int directions, int image_size, int threads) {
         DatabaseBuildOptions options;
         options.grasps = std::move(grasps);
+        options.gestures.clear();
+        for (const std::string& name : gestures) {
+          if (name == "all") {
+            options.gestures = GestureIds();
+          } else {
+            options.gestures.push_back(GestureByName(name).id);
+          }
+        }
         options.directions = directions;
         options.image_size = image_size;
         options.threads = threads;
         py::gil_scoped_release release;
         return BuildDatabase(hand, options, path, nullptr).entries;
       },
-      py::arg("hand"), py::arg("path"), py::arg("grasps") = std::vector<int>{}, py::arg("directions") = 648,
-      py::arg("image_size") = 128, py::arg("threads") = 0,
-      "Builds a database file (atomically; resumable) and returns its entry count; grasps empty: all 33");
+      py::arg("hand"), py::arg("path"), py::arg("grasps") = std::vector<int>{},
+      py::arg("gestures") = std::vector<std::string>{"all"}, py::arg("directions") = 648, py::arg("image_size") = 128,
+      py::arg("threads") = 0,
+      "Builds a database file (atomically; resumable) and returns its entry count; grasps empty: all 33; gestures: "
+      "names, ['all'] (the default) or [] for none");
 
   py::class_<Database, std::shared_ptr<Database>>(m, "Database", "A database file of (pose, descriptor) entries")
       .def(py::init([](const std::filesystem::path& path) { return std::make_shared<Database>(Database::Open(path)); }),

@@ -40,8 +40,8 @@ seeds="$cache/seeds"
 rm -rf "$seeds" "$cache/crashes"
 mkdir -p "$seeds" "$cache/crashes"
 export ASAN_OPTIONS="detect_leaks=1"
-"$build/apps/nphand" db build --grasps 1 --directions 2 --threads 1 --quiet --out "$seeds/tiny.db" >/dev/null
-"$build/apps/nphand" db build --grasps 1 --directions 2 --threads 1 --quiet --shard 1/3 --out "$seeds/shard.db" >/dev/null
+"$build/apps/nphand" db build --grasps 1 --gestures none --directions 2 --threads 1 --quiet --out "$seeds/tiny.db" >/dev/null
+"$build/apps/nphand" db build --grasps 1 --gestures none --directions 2 --threads 1 --quiet --shard 1/3 --out "$seeds/shard.db" >/dev/null
 python3 - "$seeds" <<'PY'
 import os, struct, sys, zlib
 seeds = sys.argv[1]

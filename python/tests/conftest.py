@@ -1,4 +1,4 @@
-"""Shared fixtures: one tiny database (grasp 1, 24 directions) and its exact index per run."""
+"""Shared fixtures: one tiny database (grasp 1 and the gestures, 24 directions) and its exact index per run."""
 import pytest
 
 import nphand

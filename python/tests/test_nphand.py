@@ -202,3 +202,15 @@ def test_an_index_keeps_its_database_alive(hand, tmp_path):
     frame = nphand.render(hand, grasp="large_diameter", width=320, height=240)
     result = nphand.Estimator(db, loaded, hand, k=10, faces=False).process(frame["rgb"])
     assert result.status != "no_skin", "the hand was looked up in the index"
+
+
+def test_the_database_holds_the_gestures_unless_told_otherwise(hand, tmp_path):
+    def build(name, **gestures):
+        return nphand.build_database(hand, tmp_path / name, grasps=[1], directions=8, image_size=96, threads=1,
+                                     **gestures)
+    grasp_only = build("none.db", gestures=[])
+    assert grasp_only == 1 * 5 * 2 * 8
+    assert build("peace.db", gestures=["peace"]) == grasp_only + 5 * 8
+    assert build("all.db") == grasp_only + 16 * 5 * 8
+    with pytest.raises(nphand.Error, match="unknown gesture 'wave'"):
+        build("wave.db", gestures=["wave"])

@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include "apps/eval_command.h"
+#include "nphand/db/database.h"
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
 #include "testing/testing.h"
+#include "testing/tiny_db.h"
 
 namespace nphand {
 namespace {
@@ -30,6 +32,20 @@ TEST(DbCommandTest, DestinationIsCheckedBeforeTheBuild) {
   options.out = "";
   ExpectError([&] { RunDbBuild(options); }, "the output path is empty");
   ExpectError([&] { RunDbMerge({"a.db", "b.db"}, testing::ScratchDir()); }, "is a folder");
+}
+
+// --gestures: names (as the CLI and files spell them, or as people write them), all or none.
+TEST(DbCommandTest, GesturesAreNamedOrAllOrNone) {
+  DbBuildCommandOptions options;
+  options.build = testing::TinyDatabaseOptions();
+  options.quiet = true;
+  options.out = testing::ScratchDir() / "none.db";
+  options.gestures = {"none"};
+  EXPECT_EQ(RunDbBuild(options)["entries"], 160);
+  options.out = testing::ScratchDir() / "two.db";
+  options.gestures = {"peace", "Thumbs Up"};
+  EXPECT_EQ(RunDbBuild(options)["entries"], 160 + 2 * 5 * 8);
+  EXPECT_EQ(Database::Open(options.out).header()["gesture_names"], nlohmann::json::array({"peace", "thumbs_up"}));
 }
 
 TEST(DbCommandTest, StudyOutputIsCheckedBeforeTheStudy) {

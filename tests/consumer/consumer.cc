@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
 
     nphand::DatabaseBuildOptions build;
     build.grasps = {1};
+    build.gestures = {};
     build.directions = 24;
     build.image_size = 96;
     build.threads = 1;

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "nphand/scene/grasp.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
 #include "testing/db_files.h"
@@ -48,6 +48,38 @@ TEST(BuilderTest, EntriesFollowTheEnumerationAndMatchTheirGrasp) {
     const Keypoints3d expected = RightHand().KeypointsOf(pose);
     EXPECT_LT((db.Keypoints(i)[20] - expected[20]).norm(), 1e-5);
   }
+}
+
+// Gestures follow the grasps: each its steps from every viewpoint, without an object; the
+// header names them, and a build without gestures says nothing of them (its bytes are those
+// of the files from before gestures).
+TEST(BuilderTest, GesturesFollowTheGraspsWithoutAnObject) {
+  DatabaseBuildOptions options = TinyDatabaseOptions();
+  options.gestures = {GestureByName("peace").id, GestureByName("fist").id};
+  const auto dir = testing::ScratchDir();
+  EXPECT_EQ(BuildDatabase(RightHand(), options, dir / "gestures.db", nullptr).entries, 160u + 2 * 5 * 8);
+  const Database db = Database::Open(dir / "gestures.db");
+  EXPECT_EQ(db.header()["gestures"], nlohmann::json::array({GestureByName("peace").id, GestureByName("fist").id}));
+  EXPECT_EQ(db.header()["gesture_names"], nlohmann::json::array({"peace", "fist"}));
+  EXPECT_FALSE(TinyDatabaseOptions().Header().contains("gestures"));
+  EXPECT_FALSE(TinyDatabaseOptions().Header().contains("gesture_names"));
+  const auto peace = GestureSteps(GestureByName("peace")), fist = GestureSteps(GestureByName("fist"));
+  for (size_t i = 160; i < db.size(); ++i) {
+    const EntryMeta meta = db.Meta(i);
+    const size_t view = (i - 160) % 8, step = ((i - 160) / 8) % 5, gesture = (i - 160) / 40;
+    ASSERT_EQ(meta.viewpoint, view);
+    ASSERT_EQ(meta.step, step);
+    ASSERT_FALSE(meta.with_object);
+    ASSERT_TRUE(meta.has_hand);
+    ASSERT_EQ(meta.grasp, options.gestures[gesture]);
+    const JointAngles angles = db.Angles(i);
+    for (int k = 0; k < kNumDofs; ++k) EXPECT_NEAR(angles[k], (gesture == 0 ? peace : fist)[step][k], 1e-6);
+  }
+  const nlohmann::json info = DescribeDatabase(db);
+  EXPECT_EQ(info["grasps"], 2);
+  EXPECT_EQ(info["gestures"], 2);
+  EXPECT_EQ(info["without_object"], 80 + 80);
+  EXPECT_EQ(DescribeDatabase(Database::Open(testing::BuildTinyDatabase(dir / "tiny.db")))["gestures"], 0);
 }
 
 TEST(BuilderTest, ShardsMergeIntoTheUnshardedFileByteForByte) {
@@ -238,10 +270,17 @@ TEST(BuilderTest, BadOptionsAreRefused) {
   DatabaseBuildOptions options = TinyDatabaseOptions();
   options.grasps = {0};
   EXPECT_THROW(BuildDatabase(RightHand(), options, testing::ScratchDir() / "x.db", nullptr), Error);
+  std::string why;
+  options = TinyDatabaseOptions();
+  options.gestures = {kNumGrasps};
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("gestures are hand shapes 34 to"), std::string::npos) << why;
+  options.gestures = {kFirstGestureId, kFirstGestureId};
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("a gesture is listed twice"), std::string::npos) << why;
   options = TinyDatabaseOptions();
   options.shard_index = 3;
   options.shard_count = 3;
-  std::string why;
   EXPECT_FALSE(options.Check(&why));
   EXPECT_NE(why.find("shard"), std::string::npos);
 }

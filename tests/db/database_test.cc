@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "nphand/db/builder.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
 #include "testing/db_files.h"
@@ -24,6 +25,7 @@ namespace {
 nlohmann::json SyntheticHeader(int directions, int shards) {
   DatabaseBuildOptions options;
   options.grasps = {1};
+  options.gestures = {};
   options.directions = directions;
   options.descriptor.hog.cells = 2;
   options.descriptor.hog.bins = 4;  // 16 values
@@ -163,6 +165,12 @@ TEST(DatabaseTest, HeaderSchemaIsValidatedAtOpen) {
   refuse([](nlohmann::json& h) { h["entries"] = 3; }, "'shard'");
   refuse([](nlohmann::json& h) { h["shard"]["index"] = 10; }, "'shard.index'");
   refuse([](nlohmann::json& h) { h["hand"] = "left"; }, "'hand'");
+  refuse([](nlohmann::json& h) { h["gestures"] = {kFirstGestureId}; }, "lacks the field 'gesture_names'");
+  refuse([](nlohmann::json& h) { h["gestures"] = {kNumGrasps}, h["gesture_names"] = {"fist"}; }, "'gestures[0]'");
+  refuse([](nlohmann::json& h) { h["gestures"] = {kFirstGestureId}, h["gesture_names"] = {"peace"}; },
+         "'gesture_names[0]' must be the name of gestures[0]");
+  refuse([](nlohmann::json& h) { h["gestures"] = {kFirstGestureId}, h["gesture_names"] = {"fist"}; },
+         "'total_entries' must be (grasps x 2 + gestures)");
   refuse([](nlohmann::json& h) { h = nlohmann::json::array({1, 2}); }, "not a JSON object");
 }
 

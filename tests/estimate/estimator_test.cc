@@ -14,6 +14,7 @@
 #include "nphand/estimate/frame_json.h"
 #include "nphand/eval/measures.h"
 #include "nphand/index/backends.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/sequence/sequence.h"
 #include "testing/testing.h"
@@ -34,6 +35,7 @@ class EstimatorTest : public ::testing::Test {
   static void SetUpTestSuite() {
     DatabaseBuildOptions options;
     options.grasps = {1, 13};
+    options.gestures = {};
     options.directions = 64;
     options.threads = 2;
     BuildDatabase(RightHand(), options, Path(), nullptr);
@@ -109,6 +111,47 @@ TEST_F(EstimatorTest, AFrameAtADatabaseEntryIsThatEntryAndARolledOneComesBackWit
       ASSERT_TRUE(rolled.detected());
       EXPECT_EQ(rolled.top[0].entry, e) << roll_deg;
       EXPECT_LT(RotationAngleDeg(rolled.pose.camera_from_hand, scene.hand.camera_from_hand), 4.0) << roll_deg;
+    }
+  }
+}
+
+// In a database built with gestures, a victory sign, a thumbs-up and a fist seen from views
+// between the database's are named, and the estimate's fingers are straight or curled as
+// the gesture's are.
+TEST_F(EstimatorTest, AGestureIsNamedFromADatabaseWithGestures) {
+  const std::filesystem::path path = testing::ScratchDir() / "gestures.db";
+  DatabaseBuildOptions build;
+  build.grasps = {1};
+  build.gestures = {GestureByName("peace").id, GestureByName("thumbs_up").id, GestureByName("fist").id};
+  build.directions = 64;
+  build.threads = 2;
+  BuildDatabase(RightHand(), build, path, nullptr);
+  const Database db = Database::Open(path);
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db, IndexOptions::Exact());
+  Estimator estimator(db, *index, RightHand(), Options());
+  Renderer renderer(RightHand());
+  for (const std::string name : {"peace", "thumbs_up", "fist"}) {
+    const GestureDefinition& gesture = GestureByName(name);
+    for (const Viewpoint view :
+         {Viewpoint{10 * kDeg, 12 * kDeg, 20 * kDeg}, Viewpoint{160 * kDeg, -8 * kDeg, -30 * kDeg}}) {
+      Scene scene;
+      scene.hand.angles = gesture.shape;
+      scene.hand.camera_from_hand = CameraFromHand(view);
+      scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, RightHand().bind_centre(), 0.5);
+      cv::Mat labels;
+      renderer.RenderLabels(scene, Intrinsics::FromFieldOfView(128, 128, 30 * kDeg), &labels);
+      estimator.Reset();
+      const FrameResult result = estimator.ProcessMask(labels == static_cast<int>(PixelLabel::kHand), 0.0);
+      ASSERT_TRUE(result.detected()) << name << ": " << result.reason;
+      EXPECT_EQ(result.grasps.at(0).first, name) << view.azimuth;
+      EXPECT_EQ(FrameResultJson(result, db, true)["top"][0]["grasp"], name);
+      const Keypoints3d k = RightHand().KeypointsOf(result.pose);
+      for (int f = 0; f < 4; ++f) {
+        const int m = 5 + 4 * f, t = m + 3;
+        double bones = 0.0;
+        for (int j = m; j < t; ++j) bones += (k[j + 1] - k[j]).norm();
+        EXPECT_EQ((k[t] - k[m]).norm() / bones > 0.75, gesture.extended[f]) << name << " finger " << f + 1;
+      }
     }
   }
 }

@@ -81,6 +81,7 @@ class PoseStudyTest : public ::testing::Test {
     DatabaseBuildOptions options;
     for (const StudySequence& s : TestSequences(2, 64, 64, 1)) options.grasps.push_back(s.options.grasp);
     std::sort(options.grasps.begin(), options.grasps.end());
+    options.gestures = {};
     options.directions = 96;
     options.image_size = 96;
     options.threads = 2;

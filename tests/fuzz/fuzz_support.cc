@@ -31,6 +31,7 @@ const nlohmann::json& SeedHeader() {
   static const nlohmann::json header = [] {
     DatabaseBuildOptions options;
     options.grasps = {1};
+    options.gestures = {};
     options.directions = 2;
     return options.Header();
   }();

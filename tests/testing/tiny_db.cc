@@ -9,6 +9,7 @@ namespace nphand::testing {
 DatabaseBuildOptions TinyDatabaseOptions() {
   DatabaseBuildOptions options;
   options.grasps = {1, 13};
+  options.gestures = {};
   options.directions = 8;
   options.image_size = 96;
   options.threads = 2;

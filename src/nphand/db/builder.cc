@@ -7,7 +7,7 @@
 #include <set>
 
 #include "nphand/render/renderer.h"
-#include "nphand/scene/grasp.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
@@ -36,7 +36,10 @@ struct Context {
   const HandModel& hand;
   const DatabaseBuildOptions& options;
   Enumeration enumeration;
-  std::vector<Grasp> grasps;  // in the enumeration's order
+  // Per hand shape, in the enumeration's order (grasps, then gestures): its steps' angles,
+  // and its object (none for a gesture).
+  std::vector<std::array<JointAngles, kGraspSteps>> steps;
+  std::vector<SceneObject> objects;
   std::vector<Eigen::Vector3d> directions;
   Intrinsics intrinsics;
   RecordLayout layout;
@@ -47,14 +50,14 @@ void RenderEntry(const Context& c, uint64_t index, Renderer* renderer, cv::Mat* 
                  uint64_t* no_hand) {
   Entry entry;
   entry.meta = c.enumeration.At(index);
-  const Grasp& grasp = c.grasps[c.enumeration.GraspPosition(index)];
+  const size_t shape = c.enumeration.ShapePosition(index);
 
   Scene scene;
   scene.hand.handedness = c.hand.handedness();
-  scene.hand.angles = grasp.steps[entry.meta.step];
+  scene.hand.angles = c.steps[shape][entry.meta.step];
   scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(c.directions[entry.meta.viewpoint]));
   scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, c.hand.bind_centre(), c.options.distance);
-  if (entry.meta.with_object) scene.objects = {grasp.object};
+  if (entry.meta.with_object) scene.objects = {c.objects[shape]};
   renderer->RenderLabels(scene, c.intrinsics, labels);
 
   entry.pose = ToPoseVector(scene.hand);
@@ -98,6 +101,17 @@ bool DatabaseBuildOptions::Check(std::string* why) const {
     *why = "a grasp is listed twice";
     return false;
   }
+  for (int id : gestures) {
+    if (!IsGesture(id)) {
+      *why = "gestures are hand shapes " + std::to_string(kFirstGestureId) + " to " + std::to_string(kNumHandShapes) +
+             ", got " + std::to_string(id);
+      return false;
+    }
+  }
+  if (std::set<int>(gestures.begin(), gestures.end()).size() != gestures.size()) {
+    *why = "a gesture is listed twice";
+    return false;
+  }
   if (directions < 2 || directions > 65535) {
     *why = "directions must be between 2 and 65535";
     return false;
@@ -123,7 +137,8 @@ bool DatabaseBuildOptions::Check(std::string* why) const {
 }
 
 uint64_t DatabaseBuildOptions::TotalEntries() const {
-  return static_cast<uint64_t>(GraspsOf(*this).size()) * kGraspSteps * 2 * static_cast<uint64_t>(directions);
+  return (static_cast<uint64_t>(GraspsOf(*this).size()) * 2 + gestures.size()) * kGraspSteps *
+         static_cast<uint64_t>(directions);
 }
 
 nlohmann::json DatabaseBuildOptions::Header() const {
@@ -156,6 +171,14 @@ nlohmann::json DatabaseBuildOptions::Header() const {
   // The descriptor's HOG block, with its roll normalisation in it (the file's layout).
   header["hog"] = ToJson(descriptor)["hog"];
   header["hog"]["normalize_roll"] = descriptor.normalize_roll;
+  if (!gestures.empty()) {  // a build without gestures keeps the bytes of the files before them
+    header["gestures"] = gestures;
+    std::vector<std::string> names;
+    for (int id : gestures) names.push_back(HandShapeKey(id));
+    header["gesture_names"] = names;
+    header["order"] = header["order"].get<std::string>() +
+                      ", then grasp entries + (gesture * steps + step) * viewpoints + viewpoint";
+  }
   if (shard_count > 1) {
     header["shard"] = {{"index", shard_index}, {"count", shard_count}, {"begin", begin}, {"end", end}};
   }
@@ -171,11 +194,19 @@ BuildSummary BuildDatabase(const HandModel& hand, const DatabaseBuildOptions& op
   const auto start = std::chrono::steady_clock::now();
 
   const nlohmann::json header = options.Header();
-  Context c{hand, options, Enumeration(header), {}, ViewSphereDirections(options.directions),
+  Context c{hand, options, Enumeration(header), {}, {}, ViewSphereDirections(options.directions),
             Intrinsics::FromFieldOfView(options.image_size, options.image_size, options.fov_deg * std::numbers::pi / 180.0),
             {}};
   c.layout.hog_dimension = options.descriptor.Dimension();
-  for (int id : c.enumeration.grasps) c.grasps.push_back(MakeGrasp(hand, GraspTaxonomy()[id - 1]));
+  for (int id : c.enumeration.grasps) {
+    const Grasp grasp = MakeGrasp(hand, GraspTaxonomy()[id - 1]);
+    c.steps.push_back(grasp.steps);
+    c.objects.push_back(grasp.object);
+  }
+  for (int id : c.enumeration.gestures) {
+    c.steps.push_back(GestureSteps(Gestures()[id - kFirstGestureId]));
+    c.objects.emplace_back();
+  }
 
   DatabaseWriter writer(path, header, DatabaseWriter::Mode::kResume);
   const auto [begin, end] = ShardRange(options);
@@ -253,12 +284,12 @@ void MergeDatabases(const std::vector<std::filesystem::path>& shards, const std:
 
 nlohmann::json DescribeDatabase(const Database& db) {
   uint64_t with_object = 0, no_hand = 0;
-  std::set<int> grasps, steps, viewpoints;
+  std::set<int> grasps, gestures, steps, viewpoints;
   for (size_t i = 0; i < db.size(); ++i) {
     const EntryMeta meta = db.Meta(i);
     with_object += meta.with_object;
     no_hand += !meta.has_hand;
-    grasps.insert(meta.grasp);
+    (IsGesture(meta.grasp) ? gestures : grasps).insert(meta.grasp);
     steps.insert(meta.step);
     viewpoints.insert(meta.viewpoint);
   }
@@ -266,6 +297,7 @@ nlohmann::json DescribeDatabase(const Database& db) {
   nlohmann::json info = {
       {"entries", db.size()},
       {"grasps", grasps.size()},
+      {"gestures", gestures.size()},
       {"steps", steps.size()},
       {"viewpoints", viewpoints.size()},
       {"with_object", with_object},

@@ -1,5 +1,6 @@
-// Building the database: every (grasp, step, with/without object, viewpoint) rendered,
-// segmented, cropped and described, in a fixed order, on all cores, deterministically.
+// Building the database: every (grasp, step, with/without object, viewpoint), then every
+// (gesture, step, viewpoint) if gestures are asked for, rendered, segmented, cropped and
+// described, in a fixed order, on all cores, deterministically.
 #pragma once
 
 #include <cstdint>
@@ -13,11 +14,13 @@
 #include "nphand/db/database.h"
 #include "nphand/features/descriptor.h"
 #include "nphand/model/hand_model.h"
+#include "nphand/scene/gesture.h"
 
 namespace nphand {
 
 struct DatabaseBuildOptions {
   std::vector<int> grasps;     // taxonomy numbers to include; empty: all 33
+  std::vector<int> gestures = GestureIds();  // gestures' shape numbers to include (scene/gesture.h); empty: none
   int directions = 648;        // viewing directions on the sphere (the paper's count)
   int image_size = 128;        // rendered label image side, pixels
   double fov_deg = 30.0;       // horizontal field of view

@@ -13,7 +13,7 @@
 #include <zlib.h>  // crc32_combine
 
 #include "nphand/features/hog.h"
-#include "nphand/scene/grasp.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
 
@@ -93,7 +93,9 @@ class HeaderFields {
     return value.get<bool>();
   }
   std::string String(const nlohmann::json& parent, const std::string& key, const std::string& path) const {
-    const nlohmann::json& value = At(parent, key, path);
+    return String(At(parent, key, path), path);
+  }
+  std::string String(const nlohmann::json& value, const std::string& path) const {
     NPHAND_THROW_CHECK(value.is_string(), source_, ": header field '", path, "' must be a string, not ", value.dump());
     return value.get<std::string>();
   }
@@ -203,11 +205,30 @@ void ValidateHeader(const nlohmann::json& header, const std::string& source) {
     for (size_t k = 0; k < size.size(); ++k) f.Number(size[k], at + ".size_m[" + std::to_string(k) + "]", 0.0, 10.0);
   }
 
+  size_t gestures = 0;
+  if (header.contains("gestures")) {  // optional: a build without gestures has neither field
+    const nlohmann::json& ids = f.Array(header, "gestures", "gestures");
+    const nlohmann::json& names = f.Array(header, "gesture_names", "gesture_names");
+    f.Expect(!ids.empty() && ids.size() <= kNumGestures, "gestures",
+             "must list 1 to " + std::to_string(kNumGestures) + " gestures");
+    f.Expect(names.size() == ids.size(), "gesture_names", "must name each gesture");
+    std::set<int64_t> listed;
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const std::string at = "gestures[" + std::to_string(i) + "]";
+      const int64_t id = f.Integer(ids[i], at, kFirstGestureId, kNumHandShapes);
+      listed.insert(id);
+      f.Expect(f.String(names[i], "gesture_names[" + std::to_string(i) + "]") == HandShapeKey(static_cast<int>(id)),
+               "gesture_names[" + std::to_string(i) + "]", "must be the name of " + at);
+    }
+    f.Expect(listed.size() == ids.size(), "gestures", "lists a gesture twice");
+    gestures = ids.size();
+  }
+
   const int64_t steps = f.Integer(header, "steps", "steps", 1, 255);
   const int64_t viewpoints = f.Integer(header, "viewpoints", "viewpoints", 2, 65535);
-  const uint64_t total = static_cast<uint64_t>(grasps.size()) * steps * 2 * viewpoints;
+  const uint64_t total = (static_cast<uint64_t>(grasps.size()) * 2 + gestures) * steps * viewpoints;
   f.Expect(f.Integer(header, "total_entries", "total_entries", 0, INT64_MAX) == static_cast<int64_t>(total),
-           "total_entries", "must be grasps x steps x 2 x viewpoints = " + std::to_string(total));
+           "total_entries", "must be (grasps x 2 + gestures) x steps x viewpoints = " + std::to_string(total));
   const int64_t entries = f.Integer(header, "entries", "entries", 0, static_cast<int64_t>(total));
   if (header.contains("shard")) {
     const nlohmann::json& shard = f.Object(header, "shard", "shard");
@@ -253,18 +274,28 @@ void ValidateHeader(const nlohmann::json& header, const std::string& source) {
 
 Enumeration::Enumeration(const nlohmann::json& header)
     : grasps(header["grasps"].get<std::vector<int>>()),
+      gestures(header.contains("gestures") ? header["gestures"].get<std::vector<int>>() : std::vector<int>{}),
       steps(header["steps"].get<uint64_t>()),
       viewpoints(header["viewpoints"].get<uint64_t>()),
       begin(header.contains("shard") ? header["shard"]["begin"].get<uint64_t>() : 0) {}
 
-size_t Enumeration::GraspPosition(uint64_t entry) const { return entry / viewpoints / 2 / steps; }
+size_t Enumeration::ShapePosition(uint64_t entry) const {
+  return entry < GraspEntries() ? entry / viewpoints / 2 / steps
+                                : grasps.size() + (entry - GraspEntries()) / viewpoints / steps;
+}
 
 EntryMeta Enumeration::At(uint64_t entry) const {
   EntryMeta meta;
   meta.viewpoint = static_cast<uint16_t>(entry % viewpoints);
-  meta.with_object = (entry / viewpoints) % 2 == 1;
-  meta.step = static_cast<uint8_t>((entry / viewpoints / 2) % steps);
-  meta.grasp = static_cast<uint8_t>(grasps[GraspPosition(entry)]);
+  const size_t shape = ShapePosition(entry);
+  if (entry < GraspEntries()) {
+    meta.with_object = (entry / viewpoints) % 2 == 1;
+    meta.step = static_cast<uint8_t>((entry / viewpoints / 2) % steps);
+    meta.grasp = static_cast<uint8_t>(grasps[shape]);
+  } else {
+    meta.step = static_cast<uint8_t>(((entry - GraspEntries()) / viewpoints) % steps);
+    meta.grasp = static_cast<uint8_t>(gestures[shape - grasps.size()]);
+  }
   return meta;
 }
 

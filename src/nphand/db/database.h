@@ -50,7 +50,7 @@ struct RecordLayout {
 
 // What one record says of its origin.
 struct EntryMeta {
-  uint8_t grasp = 0;         // taxonomy number 1..33
+  uint8_t grasp = 0;         // hand shape: a taxonomy number 1..33, or a gesture's (scene/gesture.h)
   uint8_t step = 0;          // 0 (pre-shape) .. 4 (grasp)
   bool with_object = false;  // rendered with the grasp's object
   bool has_hand = false;     // false when the object hides the whole hand: no features
@@ -73,19 +73,24 @@ struct Entry {
 void ValidateHeader(const nlohmann::json& header, const std::string& source);
 
 // The fixed order of the entries of a build (the header's "order"): entry
-// ((grasp position * steps + step) * 2 + with_object) * viewpoints + viewpoint; record i of
-// a shard is entry begin + i. An entry is a pure function of its number.
+// ((grasp position * steps + step) * 2 + with_object) * viewpoints + viewpoint, then, where
+// the build holds gestures, grasp entries + (gesture position * steps + step) * viewpoints +
+// viewpoint (a gesture has no object); record i of a shard is entry begin + i. An entry is
+// a pure function of its number.
 struct Enumeration {
-  std::vector<int> grasps;  // taxonomy numbers, in the build's order
+  std::vector<int> grasps;    // taxonomy numbers, in the build's order
+  std::vector<int> gestures;  // gestures' shape numbers, in the build's order (none in older files)
   uint64_t steps = 0, viewpoints = 0;
-  uint64_t begin = 0;       // the file's first entry (0 unless it is a shard)
+  uint64_t begin = 0;         // the file's first entry (0 unless it is a shard)
 
   // From a valid header (see ValidateHeader).
   explicit Enumeration(const nlohmann::json& header);
-  // What entry `entry` is: grasp (taxonomy number), step, object flag and viewpoint.
+  // What entry `entry` is: hand shape number, step, object flag and viewpoint.
   EntryMeta At(uint64_t entry) const;
-  // The position of its grasp in `grasps`.
-  size_t GraspPosition(uint64_t entry) const;
+  // The position of its hand shape in `grasps` followed by `gestures`.
+  size_t ShapePosition(uint64_t entry) const;
+  uint64_t GraspEntries() const { return grasps.size() * steps * 2 * viewpoints; }
+  uint64_t Total() const { return GraspEntries() + gestures.size() * steps * viewpoints; }
 };
 
 // Serialises entries into the record format.

@@ -10,6 +10,7 @@
 
 #include "nphand/features/crop.h"
 #include "nphand/features/descriptor.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/segment/regions.h"
 #include "nphand/util/check.h"
@@ -252,10 +253,10 @@ Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel&
   db_distance_ = render["distance_m"].get<double>();
   if (options.refine) refiner_.emplace(hand, db_intrinsics_, db_distance_, db.descriptor().Crop(), options.refinement);
   directions_ = ViewSphereDirections(db.header()["viewpoints"].get<int>());
-  grasps_.resize(kNumGrasps + 1);
+  grasps_.resize(kNumGrasps + 1);  // the grasps' objects; a gesture has none
   model_hand_length_ = ModelHandLength(db);
   entries_.resize(db.size());
-  std::array<bool, kNumGrasps + 1> with_object{};
+  std::array<bool, kNumHandShapes + 1> with_object{};
   ScanRecords(db, [&](size_t i) {
     EntryRow& row = entries_[i];
     row.meta = db.Meta(i);
@@ -753,8 +754,9 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
   for (WeightedPose& c : carried_) c.weight = carried_sum > 0.0 ? c.weight / carried_sum : 1.0 / carried_.size();
 
   // Posteriors, confidence.
-  // Summed by grasp number and by object shape (the last slot: no object); named once.
-  std::array<double, kNumGrasps + 1> grasp_mass{};
+  // Summed by hand shape (grasp or gesture) and by object shape (the last slot: no object);
+  // named once.
+  std::array<double, kNumHandShapes + 1> grasp_mass{};
   std::array<double, static_cast<int>(ObjectShape::kStick) + 2> object_mass{};
   constexpr size_t kNoObject = static_cast<int>(ObjectShape::kStick) + 1;
   double squares = 0.0, mode = 0.0;
@@ -764,8 +766,8 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     squares += h.w * h.w;
     if ((h.x - best.x).norm() < options_.sigma_x) mode += h.w;
   }
-  for (int g = 1; g <= kNumGrasps; ++g) {
-    if (grasp_mass[g] > 0.0) result->grasps.emplace_back(GraspKey(GraspTaxonomy()[g - 1]), grasp_mass[g]);
+  for (int g = 1; g <= kNumHandShapes; ++g) {
+    if (grasp_mass[g] > 0.0) result->grasps.emplace_back(HandShapeKey(g), grasp_mass[g]);
   }
   for (size_t o = 0; o < object_mass.size(); ++o) {
     if (object_mass[o] <= 0.0) continue;

@@ -5,6 +5,8 @@
 
 #include <Eigen/Geometry>
 
+#include "nphand/scene/gesture.h"
+
 namespace nphand {
 namespace {
 
@@ -82,7 +84,7 @@ nlohmann::json FrameResultJson(const FrameResult& r, const Database& db, bool wi
       top.push_back({{"entry", h.entry},
                      {"weight", h.weight},
                      {"distance", h.distance},
-                     {"grasp", GraspKey(GraspTaxonomy()[meta.grasp - 1])},
+                     {"grasp", HandShapeKey(meta.grasp)},
                      {"step", meta.step},
                      {"with_object", meta.with_object},
                      {"wrist_quaternion_wxyz", {hq.w(), hq.x(), hq.y(), hq.z()}},

@@ -206,15 +206,16 @@ std::string ToString(Digit digit) {
   return kNames[DigitIndex(digit)];
 }
 
-std::string GraspKey(const GraspDefinition& definition) {
+std::string NameKey(const std::string& name) {
   std::string key;
-  for (char c : definition.name) key.push_back(c == ' ' ? '_' : static_cast<char>(std::tolower(c)));
+  for (char c : name) key.push_back(c == ' ' ? '_' : static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
   return key;
 }
 
+std::string GraspKey(const GraspDefinition& definition) { return NameKey(definition.name); }
+
 const GraspDefinition& GraspByName(const std::string& name) {
-  std::string key;
-  for (char c : name) key.push_back(c == ' ' ? '_' : static_cast<char>(std::tolower(c)));
+  const std::string key = NameKey(name);
   std::string choices;
   for (const GraspDefinition& g : GraspTaxonomy()) {
     if (GraspKey(g) == key) return g;

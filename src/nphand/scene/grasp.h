@@ -84,6 +84,9 @@ const std::vector<GraspDefinition>& GraspTaxonomy();
 const GraspDefinition& GraspByName(const std::string& name);
 // "large_diameter": the name as the CLI and files spell it.
 std::string GraspKey(const GraspDefinition& definition);
+// A name as the CLI and files spell it: lower case, spaces as underscores ("Thumbs Up" ->
+// "thumbs_up").
+std::string NameKey(const std::string& name);
 
 struct Grasp {
   grasp_id_t id = 0;
