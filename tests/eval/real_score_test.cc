@@ -111,6 +111,47 @@ TEST(RealScoreTest, PaMpjpeAndFingerStatesCompareTheShapeOnly) {
   EXPECT_FALSE(score.hands[0].handedness_ok.has_value()) << "no side predicted";
 }
 
+// 3D keypoints whose index, middle, ring and little finger are straight (true) or folded.
+nlohmann::json HandShowing(const std::array<bool, 4>& straight) {
+  nlohmann::json points = nlohmann::json::array();
+  for (int k = 0; k < 5; ++k) points.push_back({0.01 * k, -0.01, 0.0});  // wrist, thumb
+  for (int f = 0; f < 4; ++f) {
+    const double x = 0.02 * f;
+    points.push_back({x, 0.0, 0.0});
+    points.push_back({x, 0.04, 0.0});
+    points.push_back(straight[f] ? nlohmann::json{x, 0.065, 0.0} : nlohmann::json{x, 0.04, 0.025});
+    points.push_back(straight[f] ? nlohmann::json{x, 0.085, 0.0} : nlohmann::json{x, 0.02, 0.025});
+  }
+  return points;
+}
+
+// A labelled gesture whose fingers are plain is the truth of the prediction's finger states;
+// one that leaves them open (a claw) is not scored.
+TEST(RealScoreTest, AGesturesClassFixesItsFingerStates) {
+  EXPECT_EQ(*RealGestureFingers("peace"), (std::array<bool, 4>{true, true, false, false}));
+  EXPECT_EQ(*RealGestureFingers("Thumb_Up"), (std::array<bool, 4>{false, false, false, false}));
+  EXPECT_FALSE(RealGestureFingers("grabbing").has_value());
+  EXPECT_FALSE(RealGestureFingers("holy").has_value());
+  const auto dir = testing::ScratchDir();
+  const nlohmann::json box = {10, 10, 90, 90}, points = Keypoints(50, 50);
+  Write(dir / "labels.jsonl", {{{"file", "images/hagrid_peace.png"}, {"hand", "right"}, {"bbox_px", box}, {"gesture", "peace"}},
+                               {{"file", "images/hagrid_fist.png"}, {"hand", "right"}, {"bbox_px", box}, {"gesture", "fist"}},
+                               {{"file", "images/hagrid_grabbing.png"}, {"hand", "right"}, {"bbox_px", box}, {"gesture", "grabbing"}}});
+  const nlohmann::json peace = {{"keypoints_2d_px", points}, {"keypoints_3d", HandShowing({true, true, false, false})}};
+  Write(dir / "predictions.jsonl", {{{"file", "images/hagrid_peace.png"}, {"hands", {peace}}},
+                                    {{"file", "images/hagrid_fist.png"}, {"hands", {peace}}},
+                                    {{"file", "images/hagrid_grabbing.png"}, {"hands", {peace}}}});
+  const std::vector<RealLabel> labels = ReadRealLabels(dir / "labels.jsonl");
+  const RealScore score = ScoreReal(labels, ReadRealPredictions(dir / "predictions.jsonl", labels));
+  EXPECT_EQ(*score.hands[0].gesture_finger_agree, 4);
+  EXPECT_EQ(*score.hands[1].gesture_finger_agree, 2) << "a victory sign read where the fist is";
+  EXPECT_FALSE(score.hands[2].gesture_finger_agree.has_value());
+  EXPECT_EQ(score.gt_all.gesture_finger_agree, 6);
+  EXPECT_EQ(score.gt_all.gesture_finger_total, 8);
+  EXPECT_EQ(ToJson(score)["per_source"]["hagrid"]["gesture_finger_total"], 8);
+  EXPECT_NE(FormatTable(score).find("6/8"), std::string::npos);
+}
+
 // A right palm towards the camera, fingers up: the thumb's side (index MCP) on the right.
 TEST(RealScoreTest, WhichSideFacesTheCameraFollowsTheTurnAndTheHandsSide) {
   const Eigen::Vector2d wrist(100, 200), index(120, 160), little(80, 160);

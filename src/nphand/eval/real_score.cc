@@ -179,6 +179,10 @@ RealAggregate Aggregate(const std::vector<const RealHandScore*>& rows, int extra
       a.finger_agree += *r->finger_agree;
       a.finger_total += 4;
     }
+    if (r->found && r->gesture_finger_agree.has_value()) {
+      a.gesture_finger_agree += *r->gesture_finger_agree;
+      a.gesture_finger_total += 4;
+    }
     if (r->found && r->facing_ok.has_value()) {
       ++a.facing_n;
       a.facing_correct += *r->facing_ok;
@@ -226,11 +230,30 @@ nlohmann::json ToJson(const RealAggregate& a) {
           {"pa_mpjpe_mm", Optional(a.pa_mpjpe_mm)},
           {"finger_agree", a.finger_agree},
           {"finger_total", a.finger_total},
+          {"gesture_finger_agree", a.gesture_finger_agree},
+          {"gesture_finger_total", a.gesture_finger_total},
           {"palm_back_n", a.facing_n},
           {"palm_back_correct", a.facing_correct}};
 }
 
 }  // namespace
+
+std::optional<std::array<bool, 4>> RealGestureFingers(const std::string& gesture) {
+  constexpr bool S = true, C = false;  // straight, curled: index, middle, ring, little
+  static const std::map<std::string, std::array<bool, 4>> kFingers = {
+      {"call", {C, C, C, S}},       {"dislike", {C, C, C, C}},   {"fist", {C, C, C, C}},
+      {"four", {S, S, S, S}},       {"gun", {S, S, C, C}},       {"like", {C, C, C, C}},
+      {"mid. finger", {C, S, C, C}}, {"mute", {S, C, C, C}},     {"ok", {C, S, S, S}},
+      {"one", {S, C, C, C}},        {"palm", {S, S, S, S}},      {"peace", {S, S, C, C}},
+      {"point", {S, C, C, C}},      {"Thumb_Up", {C, C, C, C}},
+      {"peace inv.", {S, S, C, C}}, {"pinkie", {C, C, C, S}},    {"rock", {S, C, C, S}},
+      {"stop", {S, S, S, S}},       {"stop inv.", {S, S, S, S}}, {"three", {S, S, S, C}},
+      {"three2", {S, S, C, C}},     {"thumb index", {S, C, C, C}}, {"two up", {S, S, C, C}},
+      {"two up inv.", {S, S, C, C}},
+  };
+  const auto it = kFingers.find(gesture);
+  return it == kFingers.end() ? std::nullopt : std::optional(it->second);
+}
 
 std::string RealSourceOf(const std::string& file) {
   const std::string base = std::filesystem::path(file).filename().string();
@@ -262,6 +285,7 @@ std::vector<RealLabel> ReadRealLabels(const std::filesystem::path& path) {
     label.source = RealSourceOf(label.file);
     label.hand = Side(j.value("hand", nlohmann::json()), where);
     if (j.contains("hand_side_by") && j["hand_side_by"].is_string()) label.hand_side_by = j["hand_side_by"].get<std::string>();
+    if (j.contains("gesture") && j["gesture"].is_string()) label.gesture = j["gesture"].get<std::string>();
     if (j.contains("keypoints_2d_px") && !j["keypoints_2d_px"].is_null()) {
       label.keypoints_2d = Points2(j["keypoints_2d_px"], true, where);
       for (int k = 0; k < kNumKeypoints; ++k) {
@@ -411,6 +435,12 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
           const std::array<bool, 4> a = FingerStates(*label.keypoints_3d), b = FingerStates(*hand.keypoints_3d);
           r.finger_agree = static_cast<int>((a[0] == b[0]) + (a[1] == b[1]) + (a[2] == b[2]) + (a[3] == b[3]));
         }
+        const std::optional<std::array<bool, 4>> shown = RealGestureFingers(label.gesture);
+        if (shown.has_value() && hand.keypoints_3d.has_value()) {
+          const std::array<bool, 4>& a = *shown;
+          const std::array<bool, 4> b = FingerStates(*hand.keypoints_3d);
+          r.gesture_finger_agree = static_cast<int>((a[0] == b[0]) + (a[1] == b[1]) + (a[2] == b[2]) + (a[3] == b[3]));
+        }
       }
       score.hands.push_back(r);
     }
@@ -478,6 +508,7 @@ nlohmann::json ToJson(const RealScore& score) {
         h["pa_ref"] = r.label->world_3d ? "keypoints_3d_world_m (MediaPipe output)" : "keypoints_3d_camera_m";
         h["finger_agree"] = *r.finger_agree;
       }
+      if (r.gesture_finger_agree.has_value()) h["gesture_finger_agree"] = *r.gesture_finger_agree;
       h["palm_back_ok"] = r.facing_ok.has_value() ? nlohmann::json(*r.facing_ok) : nlohmann::json(nullptr);
     }
     hands.push_back(h);
@@ -502,7 +533,7 @@ std::string FormatTable(const RealScore& score) {
   out << std::left << std::setw(20) << "source" << std::right << std::setw(6) << "hands" << std::setw(12) << "found"
       << std::setw(10) << "PCK.1 fnd" << std::setw(10) << "PCK.2 fnd" << std::setw(10) << "PCK.2 all" << std::setw(9)
       << "err/diag" << std::setw(11) << "handed." << std::setw(18) << "PA-MPJPE" << std::setw(10) << "fingers" << std::setw(10)
-      << "palm/back" << std::setw(6) << "extra" << "\n";
+      << "palm/back" << std::setw(10) << "gesture" << std::setw(6) << "extra" << "\n";
   const auto row = [&](const std::string& name, const RealAggregate& a) {
     const std::string found = std::to_string(a.found) + " " + figure(a.found_rate().has_value() ? std::optional(100.0 * *a.found_rate()) : std::nullopt, 0) + "%";
     const std::string handed = a.handedness_n > 0 ? std::to_string(a.handedness_correct) + "/" + std::to_string(a.handedness_n) : "-";
@@ -511,10 +542,13 @@ std::string FormatTable(const RealScore& score) {
                                                      : "-";
     const std::string fingers = a.finger_total > 0 ? std::to_string(a.finger_agree) + "/" + std::to_string(a.finger_total) : "-";
     const std::string facing = a.facing_n > 0 ? std::to_string(a.facing_correct) + "/" + std::to_string(a.facing_n) : "-";
+    const std::string gesture = a.gesture_finger_total > 0
+                                    ? std::to_string(a.gesture_finger_agree) + "/" + std::to_string(a.gesture_finger_total)
+                                    : "-";
     out << std::left << std::setw(20) << name << std::right << std::setw(6) << a.hands << std::setw(12) << found << std::setw(10)
         << figure(a.pck_01_found) << std::setw(10) << figure(a.pck_02_found) << std::setw(10) << figure(a.pck_02_all)
         << std::setw(9) << figure(a.mean_norm_err_found) << std::setw(11) << handed << std::setw(18) << pa << std::setw(10)
-        << fingers << std::setw(10) << facing << std::setw(6) << a.extra << "\n";
+        << fingers << std::setw(10) << facing << std::setw(10) << gesture << std::setw(6) << a.extra << "\n";
   };
   out << "-- ground-truth labels\n";
   for (const char* source : kGroundTruthSources) {

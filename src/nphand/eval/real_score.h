@@ -18,6 +18,10 @@
 //    landmarks), after a similarity alignment without reflection;
 //  - finger states: index to little, extended iff |MCP->tip| over the finger's bone lengths
 //    exceeds 0.75, on the label's and the prediction's 3D; agreement out of 4 per hand;
+//  - gesture finger states (nphand's own measure): where a label names a HaGRID gesture whose
+//    fingers are plain (RealGestureFingers: "peace" has the index and middle finger straight,
+//    the ring and little finger curled), the prediction's 3D finger states against them,
+//    agreement out of 4 per hand;
 //  - palm or back towards the camera (nphand's own measure; the reference has none): from
 //    the 2D keypoints and the hand's side, the sense of the turn from the wrist->index MCP
 //    ray to the wrist->little MCP ray; a right hand whose palm faces the camera turns
@@ -51,6 +55,7 @@ struct RealLabel {
   std::string source;             // freihand, onehand10k, panoptic, interhand, hagrid, tfjs_hands, mediapipe_thumbs_up, asl_video, other
   std::string hand;               // "left" or "right" as it appears in the image; empty: not given
   std::string hand_side_by;       // "source" or "eye"
+  std::string gesture;            // its class: HaGRID's ("peace", "two up inv.") or MediaPipe's ("Thumb_Up")
   std::array<std::optional<Eigen::Vector2d>, kNumKeypoints> keypoints_2d;  // pixels; unlabelled joints empty
   std::vector<int> labelled;      // the joints with a 2D position
   std::optional<Keypoints3d> keypoints_3d;  // metres: the camera's, or MediaPipe's world landmarks (video)
@@ -61,6 +66,11 @@ struct RealLabel {
   // Which image (file, frame) the line belongs to.
   std::pair<std::string, int> key() const { return {file, frame.value_or(-1)}; }
 };
+
+// The index, middle, ring and little finger's states (extended: true) a gesture class
+// shows (HaGRID's, and MediaPipe's "Thumb_Up"), for the classes that fix them; none for the
+// others (HaGRID's "grabbing" and "grip", "three3", the two-hand gestures).
+std::optional<std::array<bool, 4>> RealGestureFingers(const std::string& gesture);
 
 // The source a label file name belongs to (the reference's source_of).
 std::string RealSourceOf(const std::string& file);
@@ -103,6 +113,7 @@ struct RealHandScore {
   std::optional<bool> handedness_ok;  // found hands whose prediction has a side
   std::optional<double> pa_mpjpe_mm;  // found hands with 3D on both sides
   std::optional<int> finger_agree;    // of 4
+  std::optional<int> gesture_finger_agree;  // of 4: found hands whose label's gesture fixes its fingers
   std::optional<bool> facing_ok;      // found hands whose label's facing is judged
   std::optional<Eigen::Vector2d> centroid;  // the partner's keypoint centroid
 };
@@ -115,6 +126,7 @@ struct RealAggregate {
   int pa_mpjpe_n = 0, hands_with_3d_label = 0;
   std::optional<double> pa_mpjpe_mm;
   int finger_agree = 0, finger_total = 0;
+  int gesture_finger_agree = 0, gesture_finger_total = 0;
   int facing_n = 0, facing_correct = 0;
   std::optional<double> found_rate() const { return hands > 0 ? std::optional<double>(double(found) / hands) : std::nullopt; }
 };
