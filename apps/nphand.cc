@@ -112,6 +112,7 @@ void AddSequenceCommand(CLI::App& app, nphand::SequenceCommandOptions& o) {
   cmd->add_option("--height", s.height, "Frame height, pixels")->capture_default_str();
   cmd->add_option("--fov", s.fov_deg, "Horizontal field of view, degrees")->capture_default_str();
   cmd->add_option("--grasp", s.grasp, "Grasp, taxonomy number 1..33 (0: chosen by the seed)")->capture_default_str();
+  cmd->add_option("--gesture", o.gesture, "A gesture held without an object instead of a grasp (e.g. peace)");
   cmd->add_option("--object-scale", s.object_scale,
                   "Object size over the database's (the hand closes onto it afresh; 0: 0.8 or 1.25 by the seed)")
       ->capture_default_str();

@@ -5,6 +5,7 @@
 
 #include "apps/video_file.h"
 #include "nphand/render/draw.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/util/check.h"
 #include "nphand/util/file.h"
 #include "nphand/util/io.h"
@@ -17,6 +18,11 @@ nlohmann::json RunSequence(const SequenceCommandOptions& options, std::ostream* 
   sequence_options.forearm = ForearmKindFromString(options.forearm);
   sequence_options.background = BackgroundKindFromString(options.background);
   sequence_options.hand = HandednessFromString(options.hand);
+  if (!options.gesture.empty()) {
+    NPHAND_THROW_CHECK(sequence_options.grasp == 0, "sequence: --grasp and --gesture exclude each other");
+    sequence_options.grasp = GestureByName(options.gesture).id;
+    sequence_options.object = false;
+  }
   std::string why;
   NPHAND_THROW_CHECK(sequence_options.Check(&why), "sequence: ", why);
   CheckOutputFolder(options.out_dir, "--out");

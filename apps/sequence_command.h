@@ -18,6 +18,7 @@ namespace nphand {
 
 struct SequenceCommandOptions {
   SequenceOptions sequence;
+  std::string gesture;                   // a gesture's name: the hand shape instead of sequence.grasp, no object
   std::string forearm = "bare";          // none | bare | sleeved
   std::string background = "texture";   // plain | texture | clutter
   std::string hand = "right";

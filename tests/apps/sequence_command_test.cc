@@ -59,5 +59,19 @@ TEST(SequenceCommandTest, AHandOfOtherProportionsIsRenderedAndSaidSo) {
   testing::ExpectError([&] { RunSequence(options, nullptr); }, "--proportions takes two factors");
 }
 
+TEST(SequenceCommandTest, AGestureReplacesTheGraspAndItsObject) {
+  const auto dir = testing::ScratchDir();
+  SequenceCommandOptions options = Small(dir / "gesture");
+  options.sequence.grasp = 0;
+  options.gesture = "Thumbs Up";
+  const nlohmann::json gesture = RunSequence(options, nullptr);
+  EXPECT_EQ(gesture["grasp"]["name"], "thumbs_up");
+  EXPECT_TRUE(gesture["object"].is_null());
+  EXPECT_EQ(gesture["object_scale"], 0.0);
+  EXPECT_FALSE(FirstTruth(dir / "gesture")["object_in_view"].get<bool>());
+  options.sequence.grasp = 1;
+  testing::ExpectError([&] { RunSequence(options, nullptr); }, "--grasp and --gesture exclude each other");
+}
+
 }  // namespace
 }  // namespace nphand

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "nphand/scene/gesture.h"
 #include "nphand/scene/viewpoint.h"
 #include "testing/testing.h"
 
@@ -70,6 +71,29 @@ TEST(SequenceTest, GraspAndObjectAreNotTheDatabases) {
     EXPECT_LT(sequence.Render(0).step, 0.0);
     EXPECT_DOUBLE_EQ(sequence.Render(sequence.size() - 1).step, 4.0);
   }
+}
+
+// A gesture is held without an object: the hand forms it from more open than the
+// database's first step and ends past its last (never a database pose), clamped to its limits.
+TEST(SequenceTest, AGestureIsFormedAndHeldPastTheDatabasesSteps) {
+  SequenceOptions options = Small(testing::kTestSeed);
+  options.grasp = GestureByName("peace").id;
+  options.object = false;
+  Sequence sequence(RightHand(), options);
+  EXPECT_EQ(sequence.Describe()["grasp"], (nlohmann::json{{"id", options.grasp}, {"name", "peace"}}));
+  EXPECT_TRUE(sequence.Describe()["object"].is_null());
+  const SequenceFrame last = sequence.Render(sequence.size() - 1);
+  EXPECT_DOUBLE_EQ(last.step, 4.5);
+  EXPECT_FALSE(last.object_in_view);
+  EXPECT_EQ(cv::countNonZero(last.labels == static_cast<int>(PixelLabel::kObject)), 0);
+  const JointAngles held = GestureByName("peace").shape;
+  EXPECT_NE(last.pose.angles, held);
+  EXPECT_EQ(last.pose.angles, ClampToLimits(last.pose.angles));
+  EXPECT_NEAR(last.pose.angles[15], Dofs()[15].max_rad, 1e-9) << "the curled ring finger's PIP: at its limit";
+  options.object = true;
+  testing::ExpectError([&] { Sequence(RightHand(), options); }, "a gesture (peace) holds no object");
+  options.grasp = kNumHandShapes + 1;
+  testing::ExpectError([&] { Sequence(RightHand(), options); }, "a gesture's 34..49");
 }
 
 TEST(SequenceTest, TruthKeypointsLandOnTheRenderedHand) {

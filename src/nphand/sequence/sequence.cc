@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
+#include "nphand/scene/gesture.h"
 #include "nphand/scene/viewpoint.h"
 #include "nphand/util/check.h"
 #include "nphand/util/random.h"
@@ -67,8 +68,11 @@ bool SequenceOptions::Check(std::string* why) const {
     *why = "the frame size must be within 64..4096 pixels a side";
   } else if (!(fov_deg >= 10.0 && fov_deg <= 120.0)) {
     *why = "the field of view must be within [10, 120] degrees";
-  } else if (grasp < 0 || grasp > kNumGrasps) {
-    *why = "grasp must be a taxonomy number 1..33 (or 0: chosen by the seed)";
+  } else if (grasp < 0 || grasp > kNumHandShapes) {
+    *why = "grasp must be a taxonomy number 1..33, a gesture's 34.." + std::to_string(kNumHandShapes) +
+           " (or 0: chosen by the seed)";
+  } else if (IsGesture(grasp) && object) {
+    *why = "a gesture (" + HandShapeKey(grasp) + ") holds no object";
   } else if (!(object_scale == 0.0 || (object_scale >= 0.5 && object_scale <= 2.0))) {
     *why = "object scale must be within [0.5, 2] (or 0: chosen by the seed)";
   } else if (!(beyond_steps >= 0.0 && beyond_steps <= 1.0)) {
@@ -101,9 +105,14 @@ Sequence::Sequence(const HandModel& hand, const SequenceOptions& options)
 
   const int grasp_id = options.grasp != 0 ? options.grasp : 1 + static_cast<int>(random.UniformIndex(kNumGrasps));
   const double scale = options.object_scale != 0.0 ? options.object_scale : (random.Uniform() < 0.5 ? 0.8 : 1.25);
-  GraspDefinition definition = GraspTaxonomy()[grasp_id - 1];
-  for (double& size : definition.object.size) size *= scale;
-  grasp_ = MakeGrasp(hand, definition);
+  if (IsGesture(grasp_id)) {
+    grasp_.id = static_cast<grasp_id_t>(grasp_id);
+    grasp_.steps = GestureSteps(Gestures()[grasp_id - kFirstGestureId]);
+  } else {
+    GraspDefinition definition = GraspTaxonomy()[grasp_id - 1];
+    for (double& size : definition.object.size) size *= scale;
+    grasp_ = MakeGrasp(hand, definition);
+  }
 
   const SkinTone& tone = options.skin.empty() ? kSkinTones[random.UniformIndex(kSkinTones.size())]
                                               : SkinToneByName(options.skin);
@@ -253,7 +262,9 @@ SequenceFrame Sequence::Render(int i) {
 }
 
 nlohmann::json Sequence::Describe() const {
-  const GraspDefinition& definition = GraspTaxonomy()[grasp_.id - 1];
+  // The object's size over the database's (0 without an object; a gesture has none).
+  const double object_scale =
+      options_.object ? object().size[0] / GraspTaxonomy()[grasp_.id - 1].object.size[0] : 0.0;
   return {{"frames", options_.frames},
           {"fps", options_.fps},
           {"width", options_.width},
@@ -261,12 +272,12 @@ nlohmann::json Sequence::Describe() const {
           {"intrinsics", {{"fx", intrinsics_.fx}, {"fy", intrinsics_.fy}, {"cx", intrinsics_.cx}, {"cy", intrinsics_.cy}}},
           {"fov_deg", options_.fov_deg},
           {"hand", ToString(options_.hand)},
-          {"grasp", {{"id", grasp_.id}, {"name", GraspKey(definition)}}},
+          {"grasp", {{"id", grasp_.id}, {"name", HandShapeKey(grasp_.id)}}},
           {"object", options_.object ? nlohmann::json{{"shape", ToString(object().shape)},
                                                        {"size_m", std::vector<double>(object().size.begin(),
                                                                                       object().size.begin() + ObjectSizeCount(object().shape))}}
                                      : nlohmann::json(nullptr)},
-          {"object_scale", options_.object ? definition.object.size[0] > 0.0 ? object().size[0] / definition.object.size[0] : 1.0 : 0.0},
+          {"object_scale", object_scale},
           {"beyond_steps", options_.beyond_steps},
           {"forearm", ToString(options_.forearm)},
           {"skin", skin_},

@@ -41,7 +41,9 @@ struct SequenceOptions {
   int width = 640;
   int height = 480;
   double fov_deg = 60.0;          // horizontal, a webcam's
-  int grasp = 0;                  // taxonomy number 1..33; 0: chosen by the seed
+  // The hand shape: a grasp's taxonomy number 1..33 or a gesture's shape number (scene/
+  // gesture.h: held without an object, so `object` must be false); 0: a grasp chosen by the seed.
+  int grasp = 0;
   // The object's sizes are the grasp's times this factor, and the hand closes onto it
   // afresh, so that neither object nor grasp pose is in the database. 0: 0.8 or 1.25 by
   // the seed. 1 gives the database's object.
