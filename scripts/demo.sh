@@ -31,7 +31,7 @@ render --name taxonomy --grasp all --azimuth 25 --elevation 25 --step 0
 render --name taxonomy --grasp all --azimuth 25 --elevation 25
 render --name power_sphere --grasp power_sphere --azimuth 30 --elevation 10
 
-echo "demo: the default database (33 grasps x 5 steps x with/without object x 648 viewpoints)"
+echo "demo: the default database (33 grasps x 5 steps x with/without object x 648 viewpoints, then 16 gestures x 5 steps x 648 viewpoints)"
 "$nphand" db build --reuse --out "$root/out/nphand.db"
 "$nphand" db info "$root/out/nphand.db" --json | tee "$out/db_info.json"
 echo
