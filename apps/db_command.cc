@@ -31,14 +31,7 @@ std::pair<int, int> ParseShard(const std::string& text) {
 }  // namespace
 
 nlohmann::json RunDbBuild(DbBuildCommandOptions options) {
-  if (!options.gestures.empty()) options.build.gestures.clear();
-  for (const std::string& name : options.gestures) {
-    if (name == "all") {
-      options.build.gestures = GestureIds();
-    } else if (name != "none") {
-      options.build.gestures.push_back(GestureByName(name).id);
-    }
-  }
+  if (!options.gestures.empty()) options.build.gestures = GestureIdsNamed(options.gestures, "db build --gestures");
   if (!options.shard.empty()) {
     std::tie(options.build.shard_index, options.build.shard_count) = ParseShard(options.shard);
   }

@@ -111,7 +111,9 @@ void AddSequenceCommand(CLI::App& app, nphand::SequenceCommandOptions& o) {
   cmd->add_option("--width", s.width, "Frame width, pixels")->capture_default_str();
   cmd->add_option("--height", s.height, "Frame height, pixels")->capture_default_str();
   cmd->add_option("--fov", s.fov_deg, "Horizontal field of view, degrees")->capture_default_str();
-  cmd->add_option("--grasp", s.grasp, "Grasp, taxonomy number 1..33 (0: chosen by the seed)")->capture_default_str();
+  cmd->add_option("--grasp", s.grasp,
+                  "Grasp, taxonomy number 1..33, or a gesture's 34..49 with --no-object (0: a grasp chosen by the seed)")
+      ->capture_default_str();
   cmd->add_option("--gesture", o.gesture, "A gesture held without an object instead of a grasp (e.g. peace)");
   cmd->add_option("--object-scale", s.object_scale,
                   "Object size over the database's (the hand closes onto it afresh; 0: 0.8 or 1.25 by the seed)")
@@ -272,7 +274,8 @@ void AddDbCommand(CLI::App& app, DbArgs& a) {
   CLI::App* db = app.add_subcommand("db", "Build, merge and inspect the database of rendered hand views");
   db->require_subcommand(1);
   nphand::DatabaseBuildOptions& b = a.build.build;
-  CLI::App* build = db->add_subcommand("build", "Render every grasp, step, object/no object and viewpoint into a database");
+  CLI::App* build = db->add_subcommand(
+      "build", "Render every grasp, step, object/no object and viewpoint, then every gesture, step and viewpoint, into a database");
   build->add_option("--out", a.build.out, "Database file to write")->capture_default_str();
   AddGraspCheck(build->add_option("--grasps", b.grasps, "Taxonomy numbers to include (default: all 33)")->delimiter(','));
   build->add_option("--gestures", a.build.gestures,

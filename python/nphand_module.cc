@@ -265,14 +265,7 @@ PYBIND11_MODULE(nphand, m) {
          const std::vector<std::string>& gestures, int directions, int image_size, int threads) {
         DatabaseBuildOptions options;
         options.grasps = std::move(grasps);
-        options.gestures.clear();
-        for (const std::string& name : gestures) {
-          if (name == "all") {
-            options.gestures = GestureIds();
-          } else {
-            options.gestures.push_back(GestureByName(name).id);
-          }
-        }
+        options.gestures = GestureIdsNamed(gestures, "build_database: gestures");
         options.directions = directions;
         options.image_size = image_size;
         options.threads = threads;
@@ -283,7 +276,7 @@ PYBIND11_MODULE(nphand, m) {
       py::arg("gestures") = std::vector<std::string>{"all"}, py::arg("directions") = 648, py::arg("image_size") = 128,
       py::arg("threads") = 0,
       "Builds a database file (atomically; resumable) and returns its entry count; grasps empty: all 33; gestures: "
-      "names, ['all'] (the default) or [] for none");
+      "names, ['all'] (the default), ['none'] or [] for none");
 
   py::class_<Database, std::shared_ptr<Database>>(m, "Database", "A database file of (pose, descriptor) entries")
       .def(py::init([](const std::filesystem::path& path) { return std::make_shared<Database>(Database::Open(path)); }),

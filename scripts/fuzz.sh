@@ -34,7 +34,8 @@ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD
   >/dev/null
 cmake --build "$build" --parallel "$(nproc)" --target nphand frame_seeds "${targets[@]/#/fuzz_}"
 
-# Seeds: a real small database (and a shard of it), split the ways the targets take them.
+# Seeds: a real small database (a shard of it, and one with a gesture), split the ways the
+# targets take them.
 cache="$root/.cache/fuzz"
 seeds="$cache/seeds"
 rm -rf "$seeds" "$cache/crashes"
@@ -42,12 +43,13 @@ mkdir -p "$seeds" "$cache/crashes"
 export ASAN_OPTIONS="detect_leaks=1"
 "$build/apps/nphand" db build --grasps 1 --gestures none --directions 2 --threads 1 --quiet --out "$seeds/tiny.db" >/dev/null
 "$build/apps/nphand" db build --grasps 1 --gestures none --directions 2 --threads 1 --quiet --shard 1/3 --out "$seeds/shard.db" >/dev/null
+"$build/apps/nphand" db build --grasps 1 --gestures fist --directions 2 --threads 1 --quiet --out "$seeds/gestures.db" >/dev/null
 python3 - "$seeds" <<'PY'
 import os, struct, sys, zlib
 seeds = sys.argv[1]
 for t in ("db_file", "db_content", "db_resume", "glb", "index", "index_body"):
     os.makedirs(os.path.join(seeds, t), exist_ok=True)
-for name in ("tiny", "shard"):
+for name in ("tiny", "shard", "gestures"):
     data = open(os.path.join(seeds, name + ".db"), "rb").read()
     header_len = struct.unpack_from("<I", data, 12)[0]
     header = data[16:16 + header_len]

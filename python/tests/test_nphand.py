@@ -210,6 +210,7 @@ def test_the_database_holds_the_gestures_unless_told_otherwise(hand, tmp_path):
                                      **gestures)
     grasp_only = build("none.db", gestures=[])
     assert grasp_only == 1 * 5 * 2 * 8
+    assert build("none_named.db", gestures=["none"]) == grasp_only
     assert build("peace.db", gestures=["peace"]) == grasp_only + 5 * 8
     assert build("all.db") == grasp_only + 16 * 5 * 8
     with pytest.raises(nphand.Error, match="unknown gesture 'wave'"):

@@ -4,6 +4,7 @@
 
 #include "apps/eval_command.h"
 #include "nphand/db/database.h"
+#include "nphand/scene/gesture.h"
 #include "nphand/util/check.h"
 #include "nphand/util/io.h"
 #include "testing/testing.h"
@@ -38,6 +39,7 @@ TEST(DbCommandTest, DestinationIsCheckedBeforeTheBuild) {
 TEST(DbCommandTest, GesturesAreNamedOrAllOrNone) {
   DbBuildCommandOptions options;
   options.build = testing::TinyDatabaseOptions();
+  options.build.gestures = GestureIds();  // the library's default, which the option replaces
   options.quiet = true;
   options.out = testing::ScratchDir() / "none.db";
   options.gestures = {"none"};
@@ -46,6 +48,12 @@ TEST(DbCommandTest, GesturesAreNamedOrAllOrNone) {
   options.gestures = {"peace", "Thumbs Up"};
   EXPECT_EQ(RunDbBuild(options)["entries"], 160 + 2 * 5 * 8);
   EXPECT_EQ(Database::Open(options.out).header()["gesture_names"], nlohmann::json::array({"peace", "thumbs_up"}));
+  options.out = testing::ScratchDir() / "all.db";
+  options.build.gestures = {};
+  options.gestures = {"all"};
+  EXPECT_EQ(RunDbBuild(options)["entries"], 160 + kNumGestures * 5 * 8);
+  options.gestures = {"all", "fist"};
+  ExpectError([&] { RunDbBuild(options); }, "db build --gestures: 'all' and 'none' stand alone, not among names");
 }
 
 TEST(DbCommandTest, StudyOutputIsCheckedBeforeTheStudy) {

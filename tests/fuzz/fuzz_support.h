@@ -14,8 +14,8 @@ namespace nphand::fuzz {
 std::filesystem::path ScratchPath(const char* name);
 // Replaces the file at `path` with `bytes`.
 void WriteBytes(const std::filesystem::path& path, std::span<const uint8_t> bytes);
-// The header of `nphand db build --grasps 1 --directions 2` (20 entries), which
-// scripts/fuzz.sh builds for the seeds.
+// The header of `nphand db build --grasps 1 --gestures none --directions 2` (20 entries),
+// which scripts/fuzz.sh builds for the seeds.
 const nlohmann::json& SeedHeader();
 // Opens `path` as a database and, if it opens, reads every field of every record and
 // describes it, as `db info` and the feature study do. Returns whether it opened.

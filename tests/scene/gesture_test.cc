@@ -30,6 +30,16 @@ TEST(GestureTest, GesturesFollowTheGraspsInOneNumbering) {
   EXPECT_THROW(GestureByName("wave"), Error);
 }
 
+TEST(GestureTest, GesturesAreNamedOrAllOrNone) {
+  EXPECT_EQ(GestureIdsNamed({"all"}, "x"), GestureIds());
+  EXPECT_TRUE(GestureIdsNamed({"none"}, "x").empty());
+  EXPECT_TRUE(GestureIdsNamed({}, "x").empty());
+  EXPECT_EQ(GestureIdsNamed({"fist", "Thumbs Up"}, "x"),
+            (std::vector<int>{GestureByName("fist").id, GestureByName("thumbs_up").id}));
+  testing::ExpectError([] { GestureIdsNamed({"fist", "all"}, "--gestures"); }, "--gestures: 'all' and 'none' stand alone");
+  testing::ExpectError([] { GestureIdsNamed({"wave"}, "--gestures"); }, "unknown gesture 'wave'");
+}
+
 // What the gesture says of each finger is what its posed hand shows, judged as real-dev's
 // scorer judges finger states: extended when the MCP-to-tip distance exceeds 0.75 of the
 // finger's bone lengths.

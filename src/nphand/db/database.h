@@ -90,7 +90,6 @@ struct Enumeration {
   // The position of its hand shape in `grasps` followed by `gestures`.
   size_t ShapePosition(uint64_t entry) const;
   uint64_t GraspEntries() const { return grasps.size() * steps * 2 * viewpoints; }
-  uint64_t Total() const { return GraspEntries() + gestures.size() * steps * viewpoints; }
 };
 
 // Serialises entries into the record format.

@@ -167,7 +167,7 @@ struct FrameResult {
   bool both_turns = false;                     // the half-turned crop was searched too
   bool prior_used = false;                     // the temporal prior took part
   std::vector<Hypothesis> top;                 // the best top_n, best first
-  std::vector<std::pair<std::string, double>> grasps;   // posterior over grasp names, descending
+  std::vector<std::pair<std::string, double>> grasps;   // posterior over hand shapes (grasps, gestures), descending
   std::vector<std::pair<std::string, double>> objects;  // posterior over object shapes ("none": no object)
   bool searched = false;                       // the region was looked up in the database
   double nearest_distance = 0.0;               // the best neighbour's feature distance (if searched)

@@ -1,5 +1,7 @@
 #include "nphand/scene/gesture.h"
 
+#include <algorithm>
+
 #include "nphand/util/check.h"
 
 namespace nphand {
@@ -77,6 +79,15 @@ const GestureDefinition& GestureByName(const std::string& name) {
 std::vector<int> GestureIds() {
   std::vector<int> ids;
   for (const GestureDefinition& g : Gestures()) ids.push_back(g.id);
+  return ids;
+}
+
+std::vector<int> GestureIdsNamed(const std::vector<std::string>& names, const std::string& what) {
+  const bool word = std::any_of(names.begin(), names.end(), [](const std::string& n) { return n == "all" || n == "none"; });
+  NPHAND_THROW_CHECK(!word || names.size() == 1, what, ": 'all' and 'none' stand alone, not among names");
+  if (word) return names[0] == "all" ? GestureIds() : std::vector<int>{};
+  std::vector<int> ids;
+  for (const std::string& name : names) ids.push_back(GestureByName(name).id);
   return ids;
 }
 

@@ -34,6 +34,10 @@ struct GestureDefinition {
 const std::vector<GestureDefinition>& Gestures();
 // Their shape numbers, kFirstGestureId .. kNumHandShapes.
 std::vector<int> GestureIds();
+// The shape numbers of gestures named as a user names them: names (GestureByName), "all"
+// alone (every gesture) or "none" alone (no gesture; so does an empty list). Throws
+// nphand::Error, starting with `what`, for "all" or "none" among other names.
+std::vector<int> GestureIdsNamed(const std::vector<std::string>& names, const std::string& what);
 // The gesture named `name` (case-insensitive, spaces or underscores alike); throws
 // nphand::Error listing the names otherwise.
 const GestureDefinition& GestureByName(const std::string& name);

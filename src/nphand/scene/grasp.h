@@ -33,7 +33,7 @@ std::string ToString(Digit digit);
 
 inline constexpr int kNumGrasps = 33;
 inline constexpr int kGraspSteps = 5;
-using grasp_id_t = uint8_t;  // the taxonomy's number, 1..33
+using grasp_id_t = uint8_t;  // a hand shape's number: the taxonomy's 1..33, a gesture's after (gesture.h)
 
 // Where the object goes, from landmarks of the pre-shaped hand (hand frame).
 enum class Anchor : uint8_t {
