@@ -86,6 +86,15 @@ TEST(HandModelTest, BoneLengthsSurviveAnyPose) {
   }
 }
 
+TEST(HandModelTest, FingerStatesTellStraightFromCurled) {
+  HandPose pose;
+  EXPECT_EQ(FingerStates(RightHand().KeypointsOf(pose)), (std::array<bool, 4>{true, true, true, true}));
+  pose.angles = NamedArticulation("fist");
+  EXPECT_EQ(FingerStates(RightHand().KeypointsOf(pose)), (std::array<bool, 4>{false, false, false, false}));
+  pose.angles = NamedArticulation("point");
+  EXPECT_EQ(FingerStates(RightHand().KeypointsOf(pose)), (std::array<bool, 4>{true, false, false, false}));
+}
+
 TEST(HandModelTest, ReproportionedHandIsLongerAndNarrowerAndStillRigged) {
   const HandModel& hand = RightHand();
   const HandModel other = hand.Reproportioned(1.1, 0.9);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iomanip>
 #include <numeric>
 #include <set>
@@ -21,8 +22,6 @@ namespace {
 constexpr std::array<const char*, 5> kGroundTruthSources = {"freihand", "onehand10k", "panoptic", "interhand", "hagrid"};
 constexpr std::array<const char*, 3> kMediaPipeSources = {"tfjs_hands", "mediapipe_thumbs_up", "asl_video"};
 constexpr double kGrow = 0.25;
-constexpr double kExtendedRatio = 0.75;
-constexpr std::array<std::array<int, 4>, 4> kFingers = {{{5, 6, 7, 8}, {9, 10, 11, 12}, {13, 14, 15, 16}, {17, 18, 19, 20}}};
 
 std::string Stem(const std::string& file) { return std::filesystem::path(file).stem().string(); }
 
@@ -125,16 +124,9 @@ std::vector<int> Match(const std::vector<const RealLabel*>& labels, const std::v
   return best;
 }
 
-// Per finger (index to little): extended?
-std::array<bool, 4> FingerStates(const Keypoints3d& k) {
-  std::array<bool, 4> extended{};
-  for (size_t f = 0; f < kFingers.size(); ++f) {
-    const auto& [m, p, d, t] = kFingers[f];
-    const double bones = (k[m] - k[p]).norm() + (k[p] - k[d]).norm() + (k[d] - k[t]).norm();
-    const double ratio = bones > 0.0 ? (k[m] - k[t]).norm() / bones : 0.0;
-    extended[f] = ratio > kExtendedRatio;
-  }
-  return extended;
+// How many of the four fingers' states agree.
+int FingersAgreeing(const std::array<bool, 4>& a, const std::array<bool, 4>& b) {
+  return static_cast<int>(std::inner_product(a.begin(), a.end(), b.begin(), 0, std::plus<>(), std::equal_to<>()));
 }
 
 std::optional<double> MeanOf(const std::vector<double>& values) {
@@ -432,14 +424,11 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
         if (truth != Facing::kUnknown) r.facing_ok = FacingOf(hand.keypoints_2d, hand.hand.empty() ? label.hand : hand.hand) == truth;
         if (hand.keypoints_3d.has_value() && label.keypoints_3d.has_value()) {
           r.pa_mpjpe_mm = 1000.0 * ProcrustesError(*hand.keypoints_3d, *label.keypoints_3d);
-          const std::array<bool, 4> a = FingerStates(*label.keypoints_3d), b = FingerStates(*hand.keypoints_3d);
-          r.finger_agree = static_cast<int>((a[0] == b[0]) + (a[1] == b[1]) + (a[2] == b[2]) + (a[3] == b[3]));
+          r.finger_agree = FingersAgreeing(FingerStates(*label.keypoints_3d), FingerStates(*hand.keypoints_3d));
         }
         const std::optional<std::array<bool, 4>> shown = RealGestureFingers(label.gesture);
         if (shown.has_value() && hand.keypoints_3d.has_value()) {
-          const std::array<bool, 4>& a = *shown;
-          const std::array<bool, 4> b = FingerStates(*hand.keypoints_3d);
-          r.gesture_finger_agree = static_cast<int>((a[0] == b[0]) + (a[1] == b[1]) + (a[2] == b[2]) + (a[3] == b[3]));
+          r.gesture_finger_agree = FingersAgreeing(*shown, FingerStates(*hand.keypoints_3d));
         }
       }
       score.hands.push_back(r);

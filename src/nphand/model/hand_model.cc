@@ -87,6 +87,17 @@ double HandLength(const Keypoints3d& k) {
   return (k[9] - k[0]).norm() + (k[10] - k[9]).norm() + (k[11] - k[10]).norm() + (k[12] - k[11]).norm();
 }
 
+std::array<bool, 4> FingerStates(const Keypoints3d& k) {
+  constexpr double kStraightRatio = 0.75;
+  std::array<bool, 4> straight{};
+  for (int f = 0; f < 4; ++f) {
+    const int m = 5 + 4 * f, p = m + 1, d = m + 2, t = m + 3;  // MCP, PIP, DIP, tip
+    const double bones = (k[m] - k[p]).norm() + (k[p] - k[d]).norm() + (k[d] - k[t]).norm();
+    straight[f] = bones > 0.0 && (k[m] - k[t]).norm() / bones > kStraightRatio;
+  }
+  return straight;
+}
+
 HandModel HandModel::Load(Handedness handedness, const std::filesystem::path& asset_dir) {
   const std::filesystem::path path = asset_dir / AssetFileName(handedness);
   NPHAND_THROW_CHECK(std::filesystem::exists(path), path.string(),

@@ -42,6 +42,9 @@ using Keypoints3d = std::array<Eigen::Vector3d, kNumKeypoints>;
 // A hand's length from the wrist to the middle fingertip along its bones (keypoints 0, 9,
 // 10, 11, 12): the same in every pose, so it gives a hand's size from any of its poses.
 double HandLength(const Keypoints3d& keypoints);
+// Per finger (index, middle, ring, little): straight, when the MCP-to-tip distance exceeds
+// 0.75 of the finger's bone lengths (real-dev's scorer's finger states).
+std::array<bool, 4> FingerStates(const Keypoints3d& keypoints);
 using JointPositions = std::array<Eigen::Vector3d, kNumJoints>;
 
 class HandModel {
