@@ -106,11 +106,13 @@ cv::Mat Working(const cv::Mat& bgr, int width, int* scale) {
 // Of the skin within the faces' heads (`heads`: 255 within them; all images at the working
 // resolution, `bounds` holding the heads), what lies in front of a face: 255 where the skin
 // is parted from the skin at a face's centre (the middle half of its box, `centres`) by the
-// frame's edges, in pieces of at least `least` pixels. A hand over a face shows its outline
-// against it; the face's own edges (eyes, mouth, hair line) part smaller pieces of it, a
-// cheek or the brow, which stay the face's.
-cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& heads, cv::Rect bounds,
-                       const std::vector<cv::Rect>& centres, double least) {
+// frame's edges, in pieces of at least `least` pixels or that reach skin outside the
+// faces' shapes (`shapes`: heads and necks). A hand over a face shows its outline against
+// it; the face's own edges (eyes, mouth, hair line) part smaller pieces of it, a cheek or
+// the brow, which stay the face's. An arm or a hand passing the side of a face, within its
+// head's ellipse only in a sliver, goes on outside it.
+cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& heads, const cv::Mat& shapes,
+                       cv::Rect bounds, const std::vector<cv::Rect>& centres, double least) {
   cv::Mat in_front = cv::Mat::zeros(work.size(), CV_8UC1);
   if (bounds.area() == 0 || centres.empty()) return in_front;
   cv::Mat grey, edges;
@@ -143,6 +145,18 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
     const auto most = std::max_element(pixels.begin() + 1, pixels.end());
     if (*most > 0) face[most - pixels.begin()] = 1;
   }
+  // The pieces that reach skin outside the shapes, over what the edges and the opening
+  // took from their ends.
+  std::vector<uint8_t> goes_on(count, 0);
+  {
+    cv::Mat outside = skin(bounds) & ~shapes(bounds);
+    cv::dilate(outside, outside, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k + 2, k + 2)));
+    for (int y = 0; y < labels.rows; ++y) {
+      const int* label = labels.ptr<int>(y);
+      const uint8_t* near = outside.ptr<uint8_t>(y);
+      for (int x = 0; x < labels.cols; ++x) goes_on[label[x]] |= near[x] != 0;
+    }
+  }
   cv::Mat kept = cv::Mat::zeros(labels.size(), CV_8UC1), face_pieces = cv::Mat::zeros(labels.size(), CV_8UC1);
   for (int y = 0; y < labels.rows; ++y) {
     const int* label = labels.ptr<int>(y);
@@ -150,7 +164,7 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
     uint8_t* of_face = face_pieces.ptr<uint8_t>(y);
     for (int x = 0; x < labels.cols; ++x) {
       if (label[x] == 0) continue;
-      const bool small = stats.at<int>(label[x], cv::CC_STAT_AREA) < least;
+      const bool small = stats.at<int>(label[x], cv::CC_STAT_AREA) < least && goes_on[label[x]] == 0;
       (face[label[x]] != 0 || small ? of_face : keep)[x] = 255;
     }
   }
@@ -332,7 +346,8 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     return bounds & whole;
   };
   // Skin a face's outline parts from it (a hand in front of it), working pixels: pieces of
-  // at least kInFrontShare of the face's box (a hand near a face is about as large as it).
+  // at least kInFrontShare of the face's box (a hand near a face is about as large as it),
+  // or going on outside the heads and necks.
   cv::Mat in_front;
   if (!faces_.empty()) {
     cv::Mat face_mask = cv::Mat::zeros(work.size(), CV_8UC1);
@@ -348,7 +363,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
         centres.emplace_back(f.x + f.width / 4, f.y + f.height / 4, f.width / 2, f.height / 2);
         smallest = std::min(smallest, f.area());
       }
-      in_front = InFrontOfFaces(work, out.skin, heads, bounds, centres, kInFrontShare * smallest);
+      in_front = InFrontOfFaces(work, out.skin, heads, face_mask, bounds, centres, kInFrontShare * smallest);
       face_mask &= ~in_front;
     }
     out.face_pixels = cv::countNonZero(out.skin & face_mask) * scale * scale;
