@@ -160,6 +160,24 @@ TEST(ForearmTest, AThumbHeldOutDoesNotHideTheArm) {
       << "the fingers stay";
 }
 
+// A "call" sign on an arm: the thumb and the little finger held out up and down make the
+// slices across them far wider than the palm (their extent, not their skin); next to that
+// extent the arm would pass for a finger.
+TEST(ForearmTest, FingersSpreadSidewaysDoNotHideTheArm) {
+  cv::Mat region = cv::Mat::zeros(320, 420, CV_8UC1);
+  cv::rectangle(region, cv::Rect(20, 140, 200, 40), cv::Scalar(255), cv::FILLED);                       // arm
+  cv::circle(region, cv::Point(20, 160), 20, cv::Scalar(255), cv::FILLED);                               // its end
+  cv::ellipse(region, cv::Point(265, 160), cv::Size(50, 42), 0, 0, 360, cv::Scalar(255), cv::FILLED);  // palm
+  cv::line(region, cv::Point(270, 150), cv::Point(330, 20), cv::Scalar(255), 16);                        // thumb
+  cv::line(region, cv::Point(270, 170), cv::Point(330, 300), cv::Scalar(255), 14);                       // little finger
+  const ForearmCut c = CutForearm(region, 0);
+  ASSERT_TRUE(c.cut);
+  EXPECT_LT(c.arm_direction.x, -0.9) << "the arm is the left end";
+  EXPECT_GT(c.wrist.x, 150);
+  EXPECT_LT(c.wrist.x, 225);
+  EXPECT_EQ(cv::countNonZero(c.hand(cv::Rect(0, 0, 120, 320))), 0) << "the arm goes";
+}
+
 // Two fingers held together before a palm look like an arm before a hand: narrow, then a
 // widening. Within the frame an arm must be 1.4 of its widths long; the fingers are 1.3 and
 // stay, an arm of 1.6 is cut.

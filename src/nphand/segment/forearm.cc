@@ -115,29 +115,35 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
   }
   const int slices = static_cast<int>(std::floor(t_max - t_min)) + 1;
   if (slices < 8) return r;
-  std::vector<double> low(slices, 1e300), high(slices, -1e300);
+  std::vector<double> low(slices, 1e300), high(slices, -1e300), filled(slices, 0.0);
   for (const MaskRun& run : runs) {
     for (int x = run.x0; x <= run.x1; ++x) {
       const int k = std::min(slices - 1, static_cast<int>(f.T(x, run.y) - t_min));
       const double s = f.S(x, run.y);
       low[k] = std::min(low[k], s);
       high[k] = std::max(high[k], s);
+      filled[k] += 1.0;
     }
   }
   std::vector<double> raw(slices, 0.0);
   for (int k = 0; k < slices; ++k) raw[k] = high[k] >= low[k] ? high[k] - low[k] + 1.0 : 0.0;
   // Smooth over about 3 % of the length so that one ragged slice does not decide.
   const int half = std::max(1, slices / 60);
-  std::vector<double> width(slices, 0.0);
-  for (int k = 0; k < slices; ++k) {
-    double sum = 0.0;
-    int n = 0;
-    for (int j = std::max(0, k - half); j <= std::min(slices - 1, k + half); ++j, ++n) sum += raw[j];
-    width[k] = sum / n;
-  }
-  // The widest part, as the 90th percentile of the widths: a thumb held out sideways makes
-  // a few slices far wider than the palm, next to which the arm would pass for a finger.
-  std::vector<double> sorted = width;
+  auto smooth = [&](const std::vector<double>& in) {
+    std::vector<double> out(slices, 0.0);
+    for (int k = 0; k < slices; ++k) {
+      double sum = 0.0;
+      int n = 0;
+      for (int j = std::max(0, k - half); j <= std::min(slices - 1, k + half); ++j, ++n) sum += in[j];
+      out[k] = sum / n;
+    }
+    return out;
+  };
+  const std::vector<double> width = smooth(raw);
+  // The widest part, as the 90th percentile of the slices' skin (their pixels, not their
+  // extent): a thumb and a little finger held out sideways (the "call" sign) make slices
+  // whose extent is far wider than the palm, next to which the arm would pass for a finger.
+  std::vector<double> sorted = smooth(filled);
   const size_t percentile = (sorted.size() - 1) * 9 / 10;
   std::nth_element(sorted.begin(), sorted.begin() + percentile, sorted.end());
   const double widest = sorted[percentile];

@@ -18,8 +18,8 @@ struct ForearmCutOptions {
   // seen so far, walking from the arm's end.
   double widen_ratio = 1.3;
   // An arm is at least this wide relative to the widest part (fingers are narrower): the
-  // 90th percentile of the widths along the axis, as a thumb held out sideways can make a
-  // few slices far wider than the palm.
+  // 90th percentile of the slices' skin along the axis (their pixels, not their extent), as
+  // fingers held out sideways make slices far wider than the palm.
   double min_arm_width = 0.3;
   // ...and at least this long, in arm widths, before the cut (shorter: no forearm); a
   // group of fingers can pass for an arm, but not for a long one. On rendered sequences
