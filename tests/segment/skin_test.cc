@@ -284,7 +284,9 @@ TEST(SkinTest, AHandInFrontOfAFaceKeepsWhatItsOutlinePartsFromTheFace) {
     return best;
   };
   const double parted = covered(true), whole = covered(false);
-  EXPECT_GE(parted, 0.55);
+  // 0.67 while the kept pieces grew back only by the opening's width: the fingers over the
+  // chin, thinner than the opening and creased by their texture's edges, stayed the face's.
+  EXPECT_GE(parted, 0.75);
   EXPECT_LT(whole, 0.1);
   // The fingers the outline and the object split from it, beside the face, are no face
   // remnants: of the hand's skin, next to none is left out of the regions.

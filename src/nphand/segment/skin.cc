@@ -169,8 +169,27 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
     }
   }
   // The kept pieces grown back over what the edges and the opening took from them, short
-  // of the face's own pieces.
-  cv::dilate(kept, kept, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k + 2, k + 2)));
+  // of the face's own pieces; and on through the skin the edges do not part from them
+  // (fingers thinner than the opening, a textured hand's own creases), short of the face's
+  // pieces grown over what the opening took from their borders.
+  const cv::Mat grow = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k + 2, k + 2));
+  cv::Mat face_zone, reach_labels;
+  cv::dilate(face_pieces, face_zone, grow);
+  const cv::Mat reach = head_skin & ~edges & ~face_zone;
+  const int reaches = cv::connectedComponents(reach, reach_labels, 4, CV_32S);
+  std::vector<uint8_t> joined(reaches, 0);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* label = reach_labels.ptr<int>(y);
+    const uint8_t* keep = kept.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) joined[label[x]] |= keep[x] != 0;
+  }
+  joined[0] = 0;
+  cv::dilate(kept, kept, grow);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* label = reach_labels.ptr<int>(y);
+    uint8_t* keep = kept.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) keep[x] |= joined[label[x]] != 0 ? 255 : 0;
+  }
   in_front(bounds) = kept & head_skin & ~face_pieces;
   return in_front;
 }
