@@ -427,6 +427,39 @@ TEST_F(EstimatorTest, FramesWithoutAHandSaySo) {
   EXPECT_GT(r.nearest_distance, 0.05);
 }
 
+// A crumb of skin where the last frame held a hand (a neck's remnant below a face, left
+// when the hand's own region is judged no hand) is not looked up: a hand does not shrink to
+// an eighth of itself within a few frames. Without a hand before, it is.
+TEST_F(EstimatorTest, ACrumbOfSkinAfterAHandIsNoHand) {
+  Sequence frames(RightHand(), SmallSequence(1));
+  const SequenceFrame frame = frames.Render(0);
+  const int hand_pixels = cv::countNonZero(frame.labels == static_cast<int>(PixelLabel::kHand));
+  cv::Mat crumb = MakeBackground(BackgroundKind::kTexture, cv::Size(320, 240), 3);
+  const cv::Rect patch(200, 40, 26, 14);
+  ASSERT_LT(patch.area(), hand_pixels / 8);
+  cv::rectangle(crumb, patch, SkinToneByName("olive").bgr, cv::FILLED);
+  // After a hand and `empty` frames without skin.
+  auto after_a_hand = [&](double share, int empty) {
+    EstimatorOptions options = Options();
+    options.min_area_share = share;
+    Estimator estimator(*db_, *index_, RightHand(), options);
+    EXPECT_TRUE(estimator.Process(frame.rgb, 0.0).detected());
+    const cv::Mat wall = MakeBackground(BackgroundKind::kTexture, cv::Size(320, 240), 3);
+    for (int i = 1; i <= empty; ++i) EXPECT_FALSE(estimator.Process(wall, i / 30.0).detected());
+    return estimator.Process(crumb, (empty + 1) / 30.0);
+  };
+  for (int empty : {0, EstimatorOptions::kAreaMemory - 1}) {
+    const FrameResult r = after_a_hand(0.125, empty);
+    EXPECT_EQ(r.status, FrameStatus::kNoSkin) << empty;
+    EXPECT_FALSE(r.searched) << empty;
+    EXPECT_EQ(r.reason.rfind("no skin-coloured region near the size of the hand found last (", 0), 0u) << r.reason;
+  }
+  EXPECT_TRUE(after_a_hand(0.125, EstimatorOptions::kAreaMemory).searched) << "the hand is long gone";
+  EXPECT_TRUE(after_a_hand(0.0, 0).searched);
+  Estimator fresh(*db_, *index_, RightHand(), Options());
+  EXPECT_TRUE(fresh.Process(crumb, 0.0).searched) << "no hand before: the crumb is looked up";
+}
+
 TEST_F(EstimatorTest, AHandBesideAFaceIsFound) {
   EstimatorOptions options = Options();
   options.skin = SkinOptions{};
@@ -796,6 +829,9 @@ TEST_F(EstimatorTest, BadSetUpsAreRefused) {
   options = Options();
   options.min_hand_px = 0;
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "smallest hand");
+  options = Options();
+  options.min_area_share = 1.0;
+  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "least share of the last frame's hand");
   testing::ExpectError([&] { Estimator(*db_, *index_, testing::LeftHand(), Options()); }, "right hand model");
   // An index of another descriptor.
   IndexedSet other = DatabaseDescriptors(*db_);

@@ -183,6 +183,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the largest elongation must be at least 1 (a disk)";
   } else if (min_hand_px < 1) {
     *why = "the smallest hand must span at least 1 pixel";
+  } else if (!(min_area_share >= 0.0 && min_area_share < 1.0)) {
+    *why = "the least share of the last frame's hand must be within [0, 1)";
   } else if (!(hand_memory >= 0.0 && hand_memory < 1.0) || !(hand_switch >= 0.0 && hand_switch < 10.0)) {
     *why = "the side's memory must be within [0, 1) and its switching margin within [0, 10)";
   } else if (learn_interval < 1) {
@@ -307,6 +309,7 @@ JointAngles Estimator::AnglesOf(uint32_t entry) const {
 void Estimator::Reset() {
   carried_.clear();
   last_centre_.reset();
+  last_area_ = 0;
   segmenter_.Reset();
   frame_ = 0;
   since_learn_ = 0;
@@ -441,12 +444,21 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
   const SkinSegmentation skin = segmenter_.Segment(bgr);
   std::vector<const SkinRegion*> candidates;
   int widest = 0;
+  // Regions of a hand's size set aside as under min_area_share of the last frame's hand.
+  bool crumbs = false;
+  const int last_area = result.frame - last_area_frame_ <= EstimatorOptions::kAreaMemory ? last_area_ : 0;
+  const int least_area = static_cast<int>(std::ceil(options_.min_area_share * last_area));
   for (const SkinRegion& r : skin.regions) {
     const cv::Rect within = r.box & view;
     if (within.area() == 0 || (within != r.box && cv::countNonZero(skin.Mask({r.label}, within)) == 0)) continue;
     const int across = std::max(within.width, within.height);
     widest = std::max(widest, across);
-    if (across >= options_.min_hand_px) candidates.push_back(&r);
+    if (across < options_.min_hand_px) continue;
+    if (r.area < least_area) {
+      crumbs = true;
+      continue;
+    }
+    candidates.push_back(&r);
   }
   // Larger and nearer the last hand first.
   const double spread = 0.2 * std::hypot(bgr.cols, bgr.rows);
@@ -463,7 +475,9 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
   result.ms.segment = Ms(start, Clock::now());
   if (candidates.empty()) {
     result.status = FrameStatus::kNoSkin;
-    result.reason = widest > 0 ? "no skin-coloured region of a hand's size (the largest spans " + std::to_string(widest) +
+    result.reason = crumbs       ? "no skin-coloured region near the size of the hand found last (" + std::to_string(last_area) +
+                                     " pixels; regions under " + std::to_string(least_area) + " are not looked up)"
+                    : widest > 0 ? "no skin-coloured region of a hand's size (the largest spans " + std::to_string(widest) +
                                      " pixels; a hand at least " + std::to_string(options_.min_hand_px) + ")"
                     : roi.has_value() && !skin.regions.empty() ? "no skin-coloured region within the region of interest"
                     : skin.colourless      ? "the frame has no colour (greyscale): skin cannot be told by its colour"
@@ -506,6 +520,8 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
       if (!attempt.detected()) carried_.clear();
       if (attempt.detected()) {
         last_centre_ = cv::Point2d(attempt.box.x + 0.5 * attempt.box.width, attempt.box.y + 0.5 * attempt.box.height);
+        last_area_ = candidates[c]->area;
+        last_area_frame_ = result.frame;
         if (++since_learn_ >= options_.learn_interval && attempt.confidence >= 0.5) {
           segmenter_.Learn(bgr, hand);
           since_learn_ = 0;

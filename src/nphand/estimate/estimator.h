@@ -84,6 +84,13 @@ struct EstimatorOptions {
   // are not looked up: a frame holding only them is no_skin ("no skin-coloured region of a
   // hand's size").
   int min_hand_px = 24;
+  // A hand does not shrink to a crumb within a few frames: skin regions of less than this
+  // share of the pixels of the region where a hand was last found, within the last
+  // kAreaMemory frames, are not looked up (a neck's remnant below a face, a fold of skin on
+  // a sleeve would pass for a fist seen from afar while the hand's own region is judged no
+  // hand).
+  double min_area_share = 0.125;
+  static constexpr int kAreaMemory = 15;  // half a second at 30 frames/s
   Handedness hand = Handedness::kRight;         // left: mirrored into the right-hand database
   // Either side (`--hand auto`): each region is searched as it is and mirrored, and the side
   // whose nearest entry is nearer gains the difference of the two distances as evidence.
@@ -350,6 +357,8 @@ class Estimator {
   std::vector<uint32_t> found_in_;
   uint32_t searches_ = 0;
   std::optional<cv::Point2d> last_centre_;
+  int last_area_ = 0;        // the pixels of the region where a hand was last found (0: none)
+  int last_area_frame_ = 0;  // the frame it was found in
   OneEuroFilter smooth_wrist_, smooth_image_, smooth_angles_, smooth_rotation_;
   Handedness smoothed_side_ = Handedness::kRight;
   Handedness side_ = Handedness::kRight;  // the track's side
