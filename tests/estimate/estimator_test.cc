@@ -831,7 +831,7 @@ TEST_F(EstimatorTest, BadSetUpsAreRefused) {
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "smallest hand");
   options = Options();
   options.min_area_share = 1.0;
-  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "least share of the last frame's hand");
+  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "least share of the hand found last");
   testing::ExpectError([&] { Estimator(*db_, *index_, testing::LeftHand(), Options()); }, "right hand model");
   // An index of another descriptor.
   IndexedSet other = DatabaseDescriptors(*db_);

@@ -184,7 +184,7 @@ bool EstimatorOptions::Check(std::string* why) const {
   } else if (min_hand_px < 1) {
     *why = "the smallest hand must span at least 1 pixel";
   } else if (!(min_area_share >= 0.0 && min_area_share < 1.0)) {
-    *why = "the least share of the last frame's hand must be within [0, 1)";
+    *why = "the least share of the hand found last must be within [0, 1)";
   } else if (!(hand_memory >= 0.0 && hand_memory < 1.0) || !(hand_switch >= 0.0 && hand_switch < 10.0)) {
     *why = "the side's memory must be within [0, 1) and its switching margin within [0, 10)";
   } else if (learn_interval < 1) {
@@ -444,7 +444,7 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
   const SkinSegmentation skin = segmenter_.Segment(bgr);
   std::vector<const SkinRegion*> candidates;
   int widest = 0;
-  // Regions of a hand's size set aside as under min_area_share of the last frame's hand.
+  // Regions of a hand's size set aside as under min_area_share of the hand found last.
   bool crumbs = false;
   const int last_area = result.frame - last_area_frame_ <= EstimatorOptions::kAreaMemory ? last_area_ : 0;
   const int least_area = static_cast<int>(std::ceil(options_.min_area_share * last_area));
