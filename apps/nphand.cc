@@ -196,7 +196,8 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
       ->capture_default_str();
   cmd->add_option("--min-hand-px", e.min_hand_px, "No hand in a skin region spanning fewer pixels than this")->capture_default_str();
   cmd->add_option("--min-area-share", e.min_area_share,
-                  "No hand in a skin region of fewer pixels than this share of the hand found last (within 15 frames)")
+                  "No hand in a skin region of fewer pixels than this share of the hand found last (within " +
+                      std::to_string(nphand::EstimatorOptions::kAreaMemory) + " frames)")
       ->capture_default_str();
   cmd->add_option("--roll-ambiguity", e.roll_ambiguity,
                   "Search the half-turned crop too when the silhouette's skewness is below this (0: never)")

@@ -310,6 +310,7 @@ void Estimator::Reset() {
   carried_.clear();
   last_centre_.reset();
   last_area_ = 0;
+  last_area_frame_ = 0;
   segmenter_.Reset();
   frame_ = 0;
   since_learn_ = 0;

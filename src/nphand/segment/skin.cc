@@ -103,6 +103,18 @@ cv::Mat Working(const cv::Mat& bgr, int width, int* scale) {
   return work;
 }
 
+// By label of `labels` (CV_32SC1, `count` labels): whether any of its pixels is non-zero in
+// `mask` (CV_8UC1 of the same size).
+std::vector<uint8_t> LabelsMeeting(const cv::Mat& labels, int count, const cv::Mat& mask) {
+  std::vector<uint8_t> meets(count, 0);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* label = labels.ptr<int>(y);
+    const uint8_t* in = mask.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) meets[label[x]] |= in[x] != 0;
+  }
+  return meets;
+}
+
 // Of the skin within the faces' heads (`heads`: 255 within them; all images at the working
 // resolution, `bounds` holding the heads), what lies in front of a face: 255 where the skin
 // is parted from the skin at a face's centre (the middle half of its box, `centres`) by the
@@ -147,16 +159,10 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   }
   // The pieces that reach skin outside the shapes, over what the edges and the opening
   // took from their ends.
-  std::vector<uint8_t> goes_on(count, 0);
-  {
-    cv::Mat outside = skin(bounds) & ~shapes(bounds);
-    cv::dilate(outside, outside, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k + 2, k + 2)));
-    for (int y = 0; y < labels.rows; ++y) {
-      const int* label = labels.ptr<int>(y);
-      const uint8_t* near = outside.ptr<uint8_t>(y);
-      for (int x = 0; x < labels.cols; ++x) goes_on[label[x]] |= near[x] != 0;
-    }
-  }
+  const cv::Mat grow = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k + 2, k + 2));
+  cv::Mat outside = skin(bounds) & ~shapes(bounds);
+  cv::dilate(outside, outside, grow);
+  const std::vector<uint8_t> goes_on = LabelsMeeting(labels, count, outside);
   cv::Mat kept = cv::Mat::zeros(labels.size(), CV_8UC1), face_pieces = cv::Mat::zeros(labels.size(), CV_8UC1);
   for (int y = 0; y < labels.rows; ++y) {
     const int* label = labels.ptr<int>(y);
@@ -172,17 +178,11 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   // of the face's own pieces; and on through the skin the edges do not part from them
   // (fingers thinner than the opening, a textured hand's own creases), short of the face's
   // pieces grown over what the opening took from their borders.
-  const cv::Mat grow = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k + 2, k + 2));
   cv::Mat face_zone, reach_labels;
   cv::dilate(face_pieces, face_zone, grow);
   const cv::Mat reach = head_skin & ~edges & ~face_zone;
   const int reaches = cv::connectedComponents(reach, reach_labels, 4, CV_32S);
-  std::vector<uint8_t> joined(reaches, 0);
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* label = reach_labels.ptr<int>(y);
-    const uint8_t* keep = kept.ptr<uint8_t>(y);
-    for (int x = 0; x < labels.cols; ++x) joined[label[x]] |= keep[x] != 0;
-  }
+  std::vector<uint8_t> joined = LabelsMeeting(reach_labels, reaches, kept);
   joined[0] = 0;
   cv::dilate(kept, kept, grow);
   for (int y = 0; y < labels.rows; ++y) {
