@@ -191,6 +191,44 @@ TEST(SkinTest, TheFaceCascadeLooksWhenSomeoneComesIntoView) {
   EXPECT_EQ(after.faces, next.faces);
 }
 
+// The cascade takes a fist for a face at times. A look that a newcomer fired ignores a face
+// found where the hand just was (the newcomer was the hand's own region changing shape); a
+// look of every face_interval frames believes the cascade, so that a track that took a face
+// for the hand lets go of it.
+TEST(SkinTest, ANewcomersLookIgnoresAFaceWhereTheHandWas) {
+  SkinOptions options;
+  options.face_interval = 1000;
+  const cv::Mat wall = MakeBackground(BackgroundKind::kClutter, cv::Size(320, 240), 7);
+  cv::Mat with_face = wall.clone();
+  DrawFace(SkinToneByName("medium").bgr, cv::Point(220, 90), 120, &with_face);
+  // The wall, then someone comes into view: the frame after, a newcomer's look.
+  auto newcomers_look = [&](cv::Rect hand) {
+    SkinSegmenter segmenter(options);
+    segmenter.Segment(wall, hand);
+    segmenter.Segment(with_face, hand);
+    const SkinSegmentation look = segmenter.Segment(with_face, hand);
+    EXPECT_TRUE(look.faces_looked);
+    return look;
+  };
+  const SkinSegmentation elsewhere = newcomers_look(cv::Rect(10, 150, 60, 80));
+  ASSERT_EQ(elsewhere.faces.size(), 1u);
+  EXPECT_GT(elsewhere.face_pixels, 0);
+  const cv::Rect face = elsewhere.faces[0];
+  // A hand's box a little off the face's: most of each within the other.
+  const cv::Rect hand(face.x + face.width / 8, face.y + face.height / 8, face.width, face.height * 5 / 4);
+  const SkinSegmentation where_the_hand_was = newcomers_look(hand);
+  EXPECT_TRUE(where_the_hand_was.faces.empty());
+  EXPECT_EQ(where_the_hand_was.face_pixels, 0);
+  ASSERT_FALSE(where_the_hand_was.regions.empty());
+  EXPECT_TRUE((where_the_hand_was.regions[0].box & face).area() > face.area() / 2);
+  // A box holding the face and much more (a track on a face and its neck) is no fist.
+  const cv::Rect face_and_body(face.x - face.width, face.y, face.width * 3, 240 - face.y);
+  EXPECT_EQ(newcomers_look(face_and_body).faces.size(), 1u);
+  // The first frame's look is a periodic one.
+  SkinSegmenter first(options);
+  EXPECT_EQ(first.Segment(with_face, hand).faces.size(), 1u);
+}
+
 // Between the cascade's looks a face found is followed as the camera moves; a face that is
 // gone keeps its place until the next look.
 TEST(SkinTest, AFaceFoundIsFollowedBetweenLooks) {
@@ -391,6 +429,36 @@ TEST(SkinTest, ArmsRaisedBelowAFaceAreNoBody) {
   }
 }
 
+// Flushed fingertips and knuckles lie beyond the skin box (Cr 175-185 on a real hand under
+// warm light): such chroma is skin in a small piece that meets skin, not in a piece on its
+// own nor in a large one (a warm wall beside the hand).
+TEST(SkinTest, FlushedFingertipsJoinTheirHand) {
+  const cv::Vec3f tone = SkinToneByName("medium").bgr;
+  const cv::Scalar skin(tone[0], tone[1], tone[2]);
+  const cv::Scalar flushed(71, 83, 185);  // Y 112, Cr 180, Cb 105: a fingertip of real-dev's
+  cv::Mat frame(240, 320, CV_8UC3, cv::Scalar(200, 200, 200));
+  cv::rectangle(frame, cv::Rect(60, 100, 70, 120), skin, cv::FILLED);
+  const cv::Rect tip(80, 70, 16, 30), apart(200, 20, 16, 30), wall(130, 100, 120, 120);
+  cv::rectangle(frame, tip, flushed, cv::FILLED);
+  cv::rectangle(frame, apart, flushed, cv::FILLED);
+  cv::rectangle(frame, wall, flushed, cv::FILLED);
+  auto skin_in = [](const SkinSegmentation& s, cv::Rect r) {
+    return static_cast<double>(cv::countNonZero(Regions(s)(r))) / r.area();
+  };
+  SkinOptions options = NoFaces();
+  ASSERT_LT(tip.area(), options.rim_area * frame.total());
+  ASSERT_GT(wall.area(), options.rim_area * frame.total());
+  SkinSegmenter with_rim(options);
+  SkinSegmentation s = with_rim.Segment(frame);
+  EXPECT_GT(skin_in(s, tip), 0.9);
+  EXPECT_LT(skin_in(s, apart), 0.01);
+  EXPECT_LT(skin_in(s, wall), 0.01);
+  options.rim_area = 0.0;
+  SkinSegmenter without(options);
+  s = without.Segment(frame);
+  EXPECT_LT(skin_in(s, tip), 0.01);
+}
+
 TEST(SkinTest, BadInputIsRefused) {
   SkinSegmenter segmenter(NoFaces());
   testing::ExpectError([&] { segmenter.Segment(cv::Mat()); }, "8-bit BGR");
@@ -398,6 +466,12 @@ TEST(SkinTest, BadInputIsRefused) {
   SkinOptions options = NoFaces();
   options.cr_min = 200;
   testing::ExpectError([&] { SkinSegmenter bad(options); }, "min <= max");
+  options = NoFaces();
+  options.rim_cr_max = 150;
+  testing::ExpectError([&] { SkinSegmenter bad(options); }, "hold the skin box");
+  options = NoFaces();
+  options.rim_area = 1.0;
+  testing::ExpectError([&] { SkinSegmenter bad(options); }, "rim's largest piece");
   options = NoFaces();
   options.work_width = 10;
   testing::ExpectError([&] { SkinSegmenter bad(options); }, "working width");

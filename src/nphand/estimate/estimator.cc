@@ -311,6 +311,7 @@ void Estimator::Reset() {
   last_centre_.reset();
   last_area_ = 0;
   last_area_frame_ = 0;
+  last_box_ = cv::Rect();
   segmenter_.Reset();
   frame_ = 0;
   since_learn_ = 0;
@@ -442,12 +443,13 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
   FrameResult result;
   result.frame = frame_++;
   result.time_s = time_s;
-  const SkinSegmentation skin = segmenter_.Segment(bgr);
+  const bool recent = result.frame - last_area_frame_ <= EstimatorOptions::kAreaMemory;
+  const SkinSegmentation skin = segmenter_.Segment(bgr, recent ? last_box_ : cv::Rect());
   std::vector<const SkinRegion*> candidates;
   int widest = 0;
   // Regions of a hand's size set aside as under min_area_share of the hand found last.
   bool crumbs = false;
-  const int last_area = result.frame - last_area_frame_ <= EstimatorOptions::kAreaMemory ? last_area_ : 0;
+  const int last_area = recent ? last_area_ : 0;
   const int least_area = static_cast<int>(std::ceil(options_.min_area_share * last_area));
   for (const SkinRegion& r : skin.regions) {
     const cv::Rect within = r.box & view;
@@ -523,6 +525,7 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
         last_centre_ = cv::Point2d(attempt.box.x + 0.5 * attempt.box.width, attempt.box.y + 0.5 * attempt.box.height);
         last_area_ = candidates[c]->area;
         last_area_frame_ = result.frame;
+        last_box_ = attempt.box;
         if (++since_learn_ >= options_.learn_interval && attempt.confidence >= 0.5) {
           segmenter_.Learn(bgr, hand);
           since_learn_ = 0;

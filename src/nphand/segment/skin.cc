@@ -22,6 +22,11 @@ bool SkinOptions::Check(std::string* why) const {
   if (!byte(cr_min) || !byte(cr_max) || !byte(cb_min) || !byte(cb_max) || !byte(y_min) || cr_min > cr_max ||
       cb_min > cb_max) {
     *why = "skin box bounds must be within 0..255 with min <= max";
+  } else if (!byte(rim_cr_min) || !byte(rim_cr_max) || !byte(rim_cb_min) || !byte(rim_cb_max) || rim_cr_min > cr_min ||
+             rim_cr_max < cr_max || rim_cb_min > cb_min || rim_cb_max < cb_max) {
+    *why = "the skin rim's box must lie within 0..255 and hold the skin box";
+  } else if (!(rim_area >= 0.0 && rim_area < 1.0)) {
+    *why = "the skin rim's largest piece must be within [0, 1) of the frame";
   } else if (!(learn_rate > 0.0 && learn_rate <= 1.0) || !(keep >= 0.0 && keep <= add && add <= 1.0)) {
     *why = "skin adaptation needs 0 < learn rate <= 1 and 0 <= keep <= add <= 1";
   } else if (bins < 4 || bins > 256 || 256 % bins != 0) {
@@ -73,6 +78,8 @@ void SkinSegmenter::RebuildLookup() {
   for (int cr = 0; cr < 256; ++cr) {
     for (int cb = 0; cb < 256; ++cb) {
       const bool in_box = cr >= options_.cr_min && cr <= options_.cr_max && cb >= options_.cb_min && cb <= options_.cb_max;
+      bool rim = options_.rim_area > 0.0 && !in_box && cr >= options_.rim_cr_min && cr <= options_.rim_cr_max &&
+                 cb >= options_.rim_cb_min && cb <= options_.rim_cb_max;
       bool skin = in_box;
       if (learned_ > 0) {
         const float h = hand_hist_.at<float>(cr / shift, cb / shift), r = rest_hist_.at<float>(cr / shift, cb / shift);
@@ -80,9 +87,10 @@ void SkinSegmenter::RebuildLookup() {
         if (h + r > 1e-5f) {
           const double p = h / (h + r);
           skin = (in_box && p >= options_.keep) || p >= options_.add;
+          rim = rim && p >= options_.keep;
         }
       }
-      lookup_.at<uint8_t>(cr, cb) = skin ? 255 : 0;
+      lookup_.at<uint8_t>(cr, cb) = skin ? kSkin : rim ? kRim : 0;
     }
   }
 }
@@ -113,6 +121,24 @@ std::vector<uint8_t> LabelsMeeting(const cv::Mat& labels, int count, const cv::M
     for (int x = 0; x < labels.cols; ++x) meets[label[x]] |= in[x] != 0;
   }
   return meets;
+}
+
+// The rim's pieces (`rim`, CV_8UC1, non-zero = rim chroma) that meet `skin` (8-connected)
+// and cover at most `largest` pixels, added to `skin`.
+void AddRim(const cv::Mat& rim, int largest, cv::Mat* skin) {
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(rim, labels, stats, centroids, 8, CV_32S);
+  if (count <= 1) return;
+  cv::Mat near_skin;
+  cv::dilate(*skin, near_skin, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  std::vector<uint8_t> meets = LabelsMeeting(labels, count, near_skin & rim);
+  for (int label = 1; label < count; ++label) meets[label] &= stats.at<int>(label, cv::CC_STAT_AREA) <= largest;
+  meets[0] = 0;
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* label = labels.ptr<int>(y);
+    uint8_t* out = skin->ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) out[x] |= meets[label[x]] != 0 ? 255 : 0;
+  }
 }
 
 // Of the skin within the faces' heads (`heads`: 255 within them; all images at the working
@@ -215,7 +241,7 @@ cv::Mat SkinSegmentation::Mask(const std::vector<int>& which, cv::Rect box) cons
   return large(cv::Rect(box.x - under.x * scale, box.y - under.y * scale, box.width, box.height)) >= 128;
 }
 
-SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
+SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   NPHAND_THROW_CHECK(!bgr.empty() && bgr.type() == CV_8UC3, "skin: a frame must be a non-empty 8-bit BGR image");
   SkinSegmentation out;
   out.frame = bgr.size();
@@ -230,6 +256,11 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
     for (int x = 0; x < ycrcb.cols; ++x) {
       skin[x] = in[x][0] >= options_.y_min ? lookup_.at<uint8_t>(in[x][1], in[x][2]) : 0;
     }
+  }
+  if (options_.rim_area > 0.0) {
+    const cv::Mat rim = out.skin == kRim;
+    out.skin = out.skin == kSkin;
+    AddRim(rim, static_cast<int>(options_.rim_area * work.total()), &out.skin);
   }
   // A size in frame pixels at the working resolution: odd, so that the kernel is centred.
   auto working = [&](int px) { return ((px + scale - 1) / scale) | 1; };
@@ -248,7 +279,8 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
   // each face found is followed, as the camera moves. A face's skin (the head's ellipse and
   // the neck below it) is set aside before the regions are found, so that a hand in front
   // of a face keeps the rest of itself.
-  const bool look = frames_ % options_.face_interval == 0 || newcomer_;
+  const bool periodic = frames_ % options_.face_interval == 0;
+  const bool look = periodic || newcomer_;
   ++frames_;
   // The cascade sees the frame halved until it is at most 320 pixels wide.
   int halvings = 0;
@@ -322,6 +354,8 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr) {
       for (const cv::Rect& f : found) {
         const cv::Rect face(roi.x * scale + f.x * to_frame, roi.y * scale + f.y * to_frame, f.width * to_frame,
                             f.height * to_frame);
+        const int shared = (face & hand).area();
+        if (!periodic && 2 * shared > face.area() && 2 * shared > hand.area()) continue;
         if (std::none_of(faces_.begin(), faces_.end(), [&](const cv::Rect& g) { return (g & face).area() > 0; })) {
           faces_.push_back(face);
         }

@@ -21,6 +21,12 @@ struct SkinOptions {
   // The fixed model: a box in OpenCV's 8-bit YCrCb (Chai and Ngan's Cr 133..173, Cb 77..127)
   // above a floor of luma, below which chroma is mostly noise.
   int cr_min = 133, cr_max = 173, cb_min = 77, cb_max = 127, y_min = 30;
+  // Skin's rim: chroma in this wider box but outside the one above (flushed fingertips and
+  // knuckles reach Cr 185; a palm in cool light falls below Cr 133) is skin where it lies in
+  // a connected piece that meets skin and covers at most rim_area of the frame (a warm
+  // wall beside the hand is no fingertip). rim_area 0: no rim.
+  int rim_cr_min = 133, rim_cr_max = 190, rim_cb_min = 70, rim_cb_max = 135;
+  double rim_area = 0.015;
   // Adaptation: after Learn, a pixel is skin if it is in the box and P(hand | Cr, Cb) >=
   // keep, or anywhere if P >= add; P compares the hand's chroma histogram with the rest of
   // the frame's. Each Learn moves the histograms by learn_rate towards the new frame's.
@@ -97,8 +103,11 @@ class SkinSegmenter {
   // Throws nphand::Error for invalid options or a face cascade that cannot be loaded.
   explicit SkinSegmenter(const SkinOptions& options = {});
 
-  // Throws nphand::Error unless `bgr` is a non-empty 8-bit 3-channel image.
-  SkinSegmentation Segment(const cv::Mat& bgr);
+  // Throws nphand::Error unless `bgr` is a non-empty 8-bit 3-channel image. `hand`: where
+  // the hand was just found (frame pixels; empty: nowhere). The cascade takes a fist for a
+  // face at times; a face it finds where the hand was (most of each box within the other) is
+  // the hand.
+  SkinSegmentation Segment(const cv::Mat& bgr, cv::Rect hand = {});
 
   // Learns the hand's colours from a confidently estimated frame: `hand` (CV_8UC1 of the
   // frame's size, non-zero = the hand's pixels) against the rest of the frame.
@@ -111,7 +120,8 @@ class SkinSegmenter {
   void RebuildLookup();
 
   SkinOptions options_;
-  cv::Mat lookup_;                 // CV_8UC1, 256 x 256 over (Cr, Cb): 255 = skin
+  static constexpr uint8_t kSkin = 255, kRim = 128;
+  cv::Mat lookup_;                 // CV_8UC1, 256 x 256 over (Cr, Cb): kSkin, kRim (SkinOptions::rim_area) or 0
   cv::Mat hand_hist_, rest_hist_;  // CV_32FC1, bins x bins, each summing to 1
   int learned_ = 0;
   int frames_ = 0;
