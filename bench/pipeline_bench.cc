@@ -34,11 +34,14 @@ SkinOptions NoFaces() {
   return options;
 }
 
+// With and without skin's rim (SkinOptions::rim_area).
 void BM_SkinSegment(benchmark::State& state) {
-  SkinSegmenter segmenter(NoFaces());
+  SkinOptions options = NoFaces();
+  if (state.range(0) == 0) options.rim_area = 0.0;
+  SkinSegmenter segmenter(options);
   for (auto _ : state) benchmark::DoNotOptimize(segmenter.Segment(Frame().rgb).regions.size());
 }
-BENCHMARK(BM_SkinSegment)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SkinSegment)->ArgName("rim")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 void BM_FaceCascade(benchmark::State& state) {
   SkinOptions options;

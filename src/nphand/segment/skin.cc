@@ -123,22 +123,23 @@ std::vector<uint8_t> LabelsMeeting(const cv::Mat& labels, int count, const cv::M
   return meets;
 }
 
-// The rim's pieces (`rim`, CV_8UC1, non-zero = rim chroma) that meet `skin` (8-connected)
-// and cover at most `largest` pixels, added to `skin`.
-void AddRim(const cv::Mat& rim, int largest, cv::Mat* skin) {
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(rim, labels, stats, centroids, 8, CV_32S);
-  if (count <= 1) return;
-  cv::Mat near_skin;
-  cv::dilate(*skin, near_skin, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
-  std::vector<uint8_t> meets = LabelsMeeting(labels, count, near_skin & rim);
-  for (int label = 1; label < count; ++label) meets[label] &= stats.at<int>(label, cv::CC_STAT_AREA) <= largest;
-  meets[0] = 0;
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* label = labels.ptr<int>(y);
-    uint8_t* out = skin->ptr<uint8_t>(y);
-    for (int x = 0; x < labels.cols; ++x) out[x] |= meets[label[x]] != 0 ? 255 : 0;
+// The rim's pieces (`rim`, CV_8UC1, 255 = rim chroma; marked in passing) that meet `skin`
+// (8-connected) and cover at most `largest` pixels, added to `skin`. Only the pieces that
+// meet skin are visited, each once.
+void AddRim(int largest, cv::Mat* rim, cv::Mat* skin) {
+  constexpr uint8_t kSeen = 128, kKept = 64;
+  cv::Mat seeds;
+  cv::dilate(*skin, seeds, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  seeds &= *rim;
+  std::vector<cv::Point> at;
+  cv::findNonZero(seeds, at);
+  if (at.empty()) return;
+  for (const cv::Point& p : at) {
+    if (rim->at<uint8_t>(p) != 255) continue;  // its piece was visited
+    const int area = cv::floodFill(*rim, p, kSeen, nullptr, 0, 0, 8);
+    if (area <= largest) cv::floodFill(*rim, p, kKept, nullptr, 0, 0, 8);
   }
+  *skin |= *rim == kKept;
 }
 
 // Of the skin within the faces' heads (`heads`: 255 within them; all images at the working
@@ -258,9 +259,9 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     }
   }
   if (options_.rim_area > 0.0) {
-    const cv::Mat rim = out.skin == kRim;
+    cv::Mat rim = out.skin == kRim;
     out.skin = out.skin == kSkin;
-    AddRim(rim, static_cast<int>(options_.rim_area * work.total()), &out.skin);
+    AddRim(static_cast<int>(options_.rim_area * work.total()), &rim, &out.skin);
   }
   // A size in frame pixels at the working resolution: odd, so that the kernel is centred.
   auto working = [&](int px) { return ((px + scale - 1) / scale) | 1; };
