@@ -22,9 +22,10 @@ struct SkinOptions {
   // above a floor of luma, below which chroma is mostly noise.
   int cr_min = 133, cr_max = 173, cb_min = 77, cb_max = 127, y_min = 30;
   // Skin's rim: chroma in this wider box but outside the one above (flushed fingertips and
-  // knuckles reach Cr 185; a palm in cool light falls below Cr 133) is skin where it lies in
-  // a connected piece that meets skin and covers at most rim_area of the frame (a warm
-  // wall beside the hand is no fingertip). rim_area 0: no rim.
+  // knuckles under warm light reach Cr 185) is skin where it lies in a connected piece that
+  // meets skin and covers at most rim_area of the frame (a warm wall beside the hand is no
+  // fingertip). rim_area 0: no rim. Below Cr 133 (a palm in cool light) the rim took the
+  // shaded side of real-dev's forearm: docs/estimator.md.
   int rim_cr_min = 133, rim_cr_max = 190, rim_cb_min = 70, rim_cb_max = 135;
   double rim_area = 0.015;
   // Adaptation: after Learn, a pixel is skin if it is in the box and P(hand | Cr, Cb) >=
@@ -105,8 +106,10 @@ class SkinSegmenter {
 
   // Throws nphand::Error unless `bgr` is a non-empty 8-bit 3-channel image. `hand`: where
   // the hand was just found (frame pixels; empty: nowhere). The cascade takes a fist for a
-  // face at times; a face it finds where the hand was (most of each box within the other) is
-  // the hand.
+  // face at times: on a look that a newcomer fired (the hand's own region changing shape),
+  // a face found where the hand was (most of each box within the other) is ignored. The
+  // looks of every face_interval frames believe the cascade, so that a track on a face
+  // lets go of it.
   SkinSegmentation Segment(const cv::Mat& bgr, cv::Rect hand = {});
 
   // Learns the hand's colours from a confidently estimated frame: `hand` (CV_8UC1 of the
