@@ -429,7 +429,7 @@ TEST(SkinTest, ArmsRaisedBelowAFaceAreNoBody) {
   }
 }
 
-// Flushed fingertips and knuckles lie beyond the skin box (Cr 175-185 on a real hand under
+// Flushed fingertips and knuckles lie beyond the skin box (Cr 171-183 on a real hand under
 // warm light): such chroma is skin in a small piece that meets skin, not in a piece on its
 // own nor in a large one (a warm wall beside the hand).
 TEST(SkinTest, FlushedFingertipsJoinTheirHand) {
