@@ -308,7 +308,6 @@ JointAngles Estimator::AnglesOf(uint32_t entry) const {
 
 void Estimator::Reset() {
   carried_.clear();
-  last_centre_.reset();
   last_area_ = 0;
   last_area_frame_ = 0;
   last_box_ = cv::Rect();
@@ -465,10 +464,11 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
   }
   // Larger and nearer the last hand first.
   const double spread = 0.2 * std::hypot(bgr.cols, bgr.rows);
+  const cv::Point2d last_centre(last_box_.x + 0.5 * last_box_.width, last_box_.y + 0.5 * last_box_.height);
   auto score = [&](const SkinRegion* r) {
     double s = r->area;
-    if (last_centre_.has_value()) {
-      const cv::Point2d d = r->centroid - *last_centre_;
+    if (last_box_.area() > 0) {
+      const cv::Point2d d = r->centroid - last_centre;
       s *= std::exp(-(d.x * d.x + d.y * d.y) / (2.0 * spread * spread));
     }
     return s;
@@ -522,7 +522,6 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
       // The hand is lost: the next frame starts from its observation alone.
       if (!attempt.detected()) carried_.clear();
       if (attempt.detected()) {
-        last_centre_ = cv::Point2d(attempt.box.x + 0.5 * attempt.box.width, attempt.box.y + 0.5 * attempt.box.height);
         last_area_ = candidates[c]->area;
         last_area_frame_ = result.frame;
         last_box_ = attempt.box;

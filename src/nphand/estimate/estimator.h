@@ -356,10 +356,9 @@ class Estimator {
   std::vector<std::vector<int>> near_views_;
   std::vector<uint32_t> found_in_;
   uint32_t searches_ = 0;
-  std::optional<cv::Point2d> last_centre_;
-  int last_area_ = 0;        // the pixels of the region where a hand was last found (0: none)
+  cv::Rect last_box_;        // the box of the hand found last (frame pixels; empty: none yet)
+  int last_area_ = 0;        // the pixels of its region (0: none)
   int last_area_frame_ = 0;  // the frame it was found in
-  cv::Rect last_box_;        // the hand's box then (frame pixels)
   OneEuroFilter smooth_wrist_, smooth_image_, smooth_angles_, smooth_rotation_;
   Handedness smoothed_side_ = Handedness::kRight;
   Handedness side_ = Handedness::kRight;  // the track's side

@@ -251,18 +251,18 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   cv::Mat ycrcb;
   cv::cvtColor(work, ycrcb, cv::COLOR_BGR2YCrCb);
   out.skin.create(work.size(), CV_8UC1);
+  cv::Mat rim(work.size(), CV_8UC1);
   for (int y = 0; y < ycrcb.rows; ++y) {
     const cv::Vec3b* in = ycrcb.ptr<cv::Vec3b>(y);
     uint8_t* skin = out.skin.ptr<uint8_t>(y);
+    uint8_t* rim_row = rim.ptr<uint8_t>(y);
     for (int x = 0; x < ycrcb.cols; ++x) {
-      skin[x] = in[x][0] >= options_.y_min ? lookup_.at<uint8_t>(in[x][1], in[x][2]) : 0;
+      const uint8_t kind = in[x][0] >= options_.y_min ? lookup_.at<uint8_t>(in[x][1], in[x][2]) : 0;
+      skin[x] = kind == kSkin ? 255 : 0;
+      rim_row[x] = kind == kRim ? 255 : 0;
     }
   }
-  if (options_.rim_area > 0.0) {
-    cv::Mat rim = out.skin == kRim;
-    out.skin = out.skin == kSkin;
-    AddRim(static_cast<int>(options_.rim_area * work.total()), &rim, &out.skin);
-  }
+  if (options_.rim_area > 0.0) AddRim(static_cast<int>(options_.rim_area * work.total()), &rim, &out.skin);
   // A size in frame pixels at the working resolution: odd, so that the kernel is centred.
   auto working = [&](int px) { return ((px + scale - 1) / scale) | 1; };
   if (options_.open_px > 1) {
