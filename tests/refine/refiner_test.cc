@@ -172,6 +172,24 @@ TEST(RefinerTest, TheObjectiveNeverRisesAndLimitsHold) {
   }
 }
 
+// Moving the place only changes the crop map, not the hand: the search poses and rasterises
+// the hand once and warps that render for every trial of the place (a shifted start, which
+// the place alone mends).
+TEST(RefinerTest, TrialsOfThePlaceAloneReuseTheRender) {
+  const Eigen::Matrix3d view = CameraFromHand(ViewpointFromDirection(Eigen::Vector3d(0.3, -0.2, 1.0), 1.0));
+  const Scene start = SceneOf(HalfClosed(), view);
+  cv::Matx23d shifted = CropOf(start).crop_from_image;
+  shifted(0, 2) += 4.0;
+  shifted(1, 2) -= 3.0;
+  RefineOptions place_only;
+  place_only.move_wrist = false;
+  Refiner placer(RightHand(), Camera(), kDistance, Crop(), place_only);
+  const Refinement placed = placer.Refine(CropOf(start), start, shifted);
+  ASSERT_TRUE(placed.moved);
+  EXPECT_LT(placed.disagreement_after, 0.5 * placed.disagreement_before);
+  EXPECT_EQ(placed.renders, 1) << "one render, warped for every trial";
+}
+
 TEST(RefinerTest, TheSameInputGivesTheSameBytes) {
   const Eigen::Matrix3d view = CameraFromHand(ViewpointFromDirection(Eigen::Vector3d(-0.5, 0.2, 1.0), 1.0));
   const Scene start = SceneOf(HalfClosed(), AxisAngle(Eigen::Vector3d::UnitY(), 0.15) * view);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <numbers>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -207,7 +208,7 @@ const HandModel& Refiner::Model(double width) {
   return WidthOnGrid(width) == 1.0 ? hand_model_ : *ProportionedOf(width).model;
 }
 
-cv::Mat Refiner::Silhouette(const Scene& scene, double width, const cv::Matx23d& crop_from_small, cv::Mat* object) {
+void Refiner::RenderSmall(const Scene& scene, double width) {
   (WidthOnGrid(width) == 1.0 ? renderer_ : *ProportionedOf(width).renderer).RenderLabels(scene, small_, &labels_);
   hand_.create(labels_.size(), CV_32FC2);
   for (int y = 0; y < labels_.rows; ++y) {
@@ -218,6 +219,9 @@ cv::Mat Refiner::Silhouette(const Scene& scene, double width, const cv::Matx23d&
                          label[x] == static_cast<uint8_t>(PixelLabel::kObject) ? 1.0f : 0.0f);
     }
   }
+}
+
+cv::Mat Refiner::Silhouette(const cv::Matx23d& crop_from_small, cv::Mat* object) const {
   cv::Mat both;
   cv::warpAffine(hand_, both, crop_from_small, cv::Size(crop_.size, crop_.size), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0.0);
   cv::Mat planes[2];
@@ -289,11 +293,18 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
     const double angle = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), -p[kPlace + 3]) * wrist(p), *previous);
     return options_.track * (angle / 90.0) * (angle / 90.0);
   };
+  // The parameters of the last render: a trial that moves only the place (the crop map)
+  // warps it again without posing and rasterising the hand anew.
+  std::optional<Parameters> rendered;
   auto evaluate = [&](const Parameters& p, double* disagreement) {
     pose(p);
-    ++out.renders;
+    if (!rendered.has_value() || !std::equal(p.begin(), p.begin() + kPlace, rendered->begin()) || p[kWidth] != (*rendered)[kWidth]) {
+      RenderSmall(scene, p[kWidth]);
+      rendered = p;
+      ++out.renders;
+    }
     cv::Mat object;
-    cv::Mat hand = Silhouette(scene, p[kWidth], Compose(crop_from_image(p), image_from_small), &object);
+    cv::Mat hand = Silhouette(Compose(crop_from_image(p), image_from_small), &object);
     if (options_.blur_px > 0.0) cv::GaussianBlur(hand, hand, cv::Size(), options_.blur_px);
     *disagreement = Disagreement(hand, goal, options_.object_unknown && !start.objects.empty() ? &object : nullptr);
     return *disagreement + prior(p) + pull(p);

@@ -89,7 +89,7 @@ struct Refinement {
   double width = 1.0;                // the hand's width factor the search used (the one given, on the grid)
   double width_measured = 1.0;       // with move_proportions and move_width: the width the silhouette favours
   double width_disagreement = 1.0;   // and 1 - IoU there (from the start's pose, its place settled)
-  int renders = 0;
+  int renders = 0;                   // the hand posed and rasterised (a trial of the place alone reuses the last)
   bool moved = false;                // the pose or place changed
 };
 
@@ -127,10 +127,12 @@ class Refiner {
   const HandModel& Model(double width);
 
  private:
-  // The coverage of `scene`'s hand (`width` times as wide as the database's) in the crop,
-  // rendered at the search's resolution and warped by `crop_from_small`; `object` gets its
-  // object's.
-  cv::Mat Silhouette(const Scene& scene, double width, const cv::Matx23d& crop_from_small, cv::Mat* object);
+  // Renders `scene`'s hand (`width` times as wide as the database's) at the search's
+  // resolution into hand_: its coverage and its object's.
+  void RenderSmall(const Scene& scene, double width);
+  // The last render's hand coverage in the crop, warped by `crop_from_small`; `object` gets
+  // its object's.
+  cv::Mat Silhouette(const cv::Matx23d& crop_from_small, cv::Mat* object) const;
   struct Proportioned {
     std::unique_ptr<HandModel> model;
     std::unique_ptr<Renderer> renderer;
