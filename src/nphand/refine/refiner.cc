@@ -296,9 +296,12 @@ Refinement Refiner::Refine(const HandCrop& target, const Scene& start, const cv:
   // The parameters of the last render: a trial that moves only the place (the crop map)
   // warps it again without posing and rasterising the hand anew.
   std::optional<Parameters> rendered;
+  auto same_hand = [](const Parameters& a, const Parameters& b) {
+    return std::equal(a.begin(), a.begin() + kPlace, b.begin()) && a[kWidth] == b[kWidth];
+  };
   auto evaluate = [&](const Parameters& p, double* disagreement) {
-    pose(p);
-    if (!rendered.has_value() || !std::equal(p.begin(), p.begin() + kPlace, rendered->begin()) || p[kWidth] != (*rendered)[kWidth]) {
+    if (!rendered.has_value() || !same_hand(p, *rendered)) {
+      pose(p);
       RenderSmall(scene, p[kWidth]);
       rendered = p;
       ++out.renders;
