@@ -21,6 +21,20 @@ cv::Mat Regions(const SkinSegmentation& segmentation) {
   return segmentation.Mask(labels, cv::Rect(cv::Point(0, 0), segmentation.frame));
 }
 
+// The cascade looks at the first frame, then only when something calls for it.
+SkinOptions LookingAtFirst() {
+  SkinOptions options;
+  options.face_interval = 1000;
+  return options;
+}
+
+// `wall` with a face of `tone` at `centre`, `height` pixels tall.
+cv::Mat WithFace(const cv::Mat& wall, const char* tone, cv::Point centre, int height) {
+  cv::Mat frame = wall.clone();
+  DrawFace(SkinToneByName(tone).bgr, centre, height, &frame);
+  return frame;
+}
+
 SkinOptions NoFaces() {
   SkinOptions options;
   options.face_cascade.clear();
@@ -196,11 +210,9 @@ TEST(SkinTest, TheFaceCascadeLooksWhenSomeoneComesIntoView) {
 // look of every face_interval frames believes the cascade, so that a track that took a face
 // for the hand lets go of it.
 TEST(SkinTest, ANewcomersLookIgnoresAFaceWhereTheHandWas) {
-  SkinOptions options;
-  options.face_interval = 1000;
+  const SkinOptions options = LookingAtFirst();
   const cv::Mat wall = MakeBackground(BackgroundKind::kClutter, cv::Size(320, 240), 7);
-  cv::Mat with_face = wall.clone();
-  DrawFace(SkinToneByName("medium").bgr, cv::Point(220, 90), 120, &with_face);
+  const cv::Mat with_face = WithFace(wall, "medium", cv::Point(220, 90), 120);
   // The wall, then someone comes into view: the frame after, a newcomer's look.
   auto newcomers_look = [&](cv::Rect hand) {
     SkinSegmenter segmenter(options);
@@ -290,6 +302,71 @@ TEST(SkinTest, AFaceCoveredAtALookIsKeptWhileItStillMatches) {
   const SkinSegmentation gone = segmenter.Segment(wall);
   EXPECT_TRUE(gone.faces_looked);
   EXPECT_TRUE(gone.faces.empty());
+}
+
+// A face's box, found before a hand came over it, is looked for again every face_relook
+// frames while the hand found last lies half or more within it; elsewhere the hand leaves
+// the looks to face_interval.
+TEST(SkinTest, AFaceIsLookedForAgainWhileTheHandIsOverIt) {
+  const cv::Mat frame = WithFace(MakeBackground(BackgroundKind::kClutter, cv::Size(640, 480), 3), "olive", cv::Point(300, 220), 180);
+  auto looks = [&](bool over_face) {
+    SkinSegmenter segmenter(LookingAtFirst());
+    const SkinSegmentation first = segmenter.Segment(frame);
+    EXPECT_TRUE(first.faces_looked);
+    EXPECT_EQ(first.faces.size(), 1u);
+    const cv::Rect face = first.faces.empty() ? cv::Rect() : first.faces[0];
+    // Over the face: its box a little off the face's, most of it within; or far from it.
+    const cv::Rect hand = over_face ? cv::Rect(face.x + face.width / 3, face.y, face.width, face.height) : cv::Rect(10, 10, 60, 80);
+    std::vector<int> looked;
+    for (int f = 1; f <= 11; ++f) {
+      const SkinSegmentation s = segmenter.Segment(frame, hand);
+      EXPECT_EQ(s.faces.size(), 1u) << f;
+      if (s.faces_looked) looked.push_back(f);
+    }
+    return looked;
+  };
+  EXPECT_EQ(looks(true), std::vector<int>({5, 10}));
+  EXPECT_TRUE(looks(false).empty());
+}
+
+// What the set-aside head leaves beside a face is a sliver (a cheek, the edge of a neck); a
+// region of a hand's size there (kInFrontShare of the face's box) stays a region. Here a
+// hand of the face's colour lies against its cheek, with no outline between them: the part
+// within the head's ellipse (0.7 of the face's width each way) goes with the face, the rest
+// lies within a fifth of a face's width past it.
+TEST(SkinTest, AHandBesideAFaceIsNoLeftoverOfIt) {
+  const cv::Vec3f skin = SkinToneByName("light").bgr;
+  const cv::Mat face_only = WithFace(MakeBackground(BackgroundKind::kClutter, cv::Size(640, 480), 3), "light", cv::Point(300, 220), 200);
+  SkinSegmenter finder(LookingAtFirst());
+  const SkinSegmentation found = finder.Segment(face_only);
+  ASSERT_EQ(found.faces.size(), 1u);
+  ASSERT_TRUE(found.regions.empty());
+  const cv::Rect face = found.faces[0];
+  const cv::Point centre(face.x + face.width / 2, face.y + face.height / 2);
+  const int w = face.width;
+  // The regions left with a band against the cheek from 0.3 to 0.85 of the face's width
+  // right of its centre, `half` of it high each way; and its pixels outside the head.
+  auto with_band = [&](int half, int* outside) {
+    cv::Mat frame = face_only.clone();
+    const cv::Rect band(centre.x + w * 3 / 10, centre.y - half, w * 55 / 100, 2 * half);
+    frame(band).setTo(cv::Scalar(skin[0], skin[1], skin[2]));
+    cv::Mat head = cv::Mat::zeros(frame.size(), CV_8UC1);
+    cv::ellipse(head, centre, cv::Size(w * 7 / 10, face.height * 9 / 10), 0, 0, 360, cv::Scalar(255), cv::FILLED);
+    *outside = band.area() - cv::countNonZero(head(band));
+    // The face found before the hand came, and followed.
+    SkinSegmenter segmenter(LookingAtFirst());
+    segmenter.Segment(face_only);
+    const SkinSegmentation s = segmenter.Segment(frame);
+    EXPECT_FALSE(s.faces_looked);
+    EXPECT_EQ(s.faces.size(), 1u);
+    for (const cv::Rect& f : s.faces) EXPECT_LE(std::abs(f.x - face.x) + std::abs(f.y - face.y), 4);
+    return s.regions.size();
+  };
+  int hand = 0, sliver = 0;
+  EXPECT_EQ(with_band(w * 7 / 10, &hand), 1u);
+  EXPECT_EQ(with_band(w / 5, &sliver), 0u);
+  EXPECT_GT(hand, 0.15 * face.area());
+  EXPECT_LT(sliver, 0.15 * face.area());
 }
 
 // A hand held in front of a face, its forearm coming in from the frame's edge (the demo's

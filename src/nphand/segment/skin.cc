@@ -35,8 +35,8 @@ bool SkinOptions::Check(std::string* why) const {
     *why = "skin morphology sizes must be within 0..31 pixels";
   } else if (!(min_area > 0.0 && min_area < 1.0)) {
     *why = "the smallest skin region must be within (0, 1) of the frame";
-  } else if (face_interval < 1) {
-    *why = "the face interval must be at least 1 frame";
+  } else if (face_interval < 1 || face_relook < 1) {
+    *why = "the face interval and relook must be at least 1 frame";
   } else if (work_width != 0 && work_width < 64) {
     *why = "the working width must be 0 (the frame's) or at least 64 pixels";
   } else {
@@ -67,6 +67,7 @@ void SkinSegmenter::Reset() {
   frames_ = 0;
   face_sized_.clear();
   newcomer_ = false;
+  last_look_ = 0;
   faces_.clear();
   face_looks_.clear();
   RebuildLookup();
@@ -274,14 +275,19 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     cv::morphologyEx(out.skin, out.skin, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
   }
 
-  // Faces: looked for every face_interval frames, and at once when a region that could hold
+  // Faces: looked for every face_interval frames, at once when a region that could hold
   // one came into view on the last frame (someone came in; a hand split by its object, or
-  // moving, is not new); the cascade costs more than the rest of the frame. Between looks
+  // moving, is not new), and every face_relook frames while the hand is over a face's box;
+  // the cascade costs more than the rest of the frame. Between looks
   // each face found is followed, as the camera moves. A face's skin (the head's ellipse and
   // the neck below it) is set aside before the regions are found, so that a hand in front
   // of a face keeps the rest of itself.
   const bool periodic = frames_ % options_.face_interval == 0;
-  const bool look = periodic || newcomer_;
+  const bool hand_over_face = hand.area() > 0 && std::any_of(faces_.begin(), faces_.end(), [&](const cv::Rect& face) {
+    return 2 * (face & hand).area() >= hand.area();
+  });
+  const bool look = periodic || newcomer_ || (hand_over_face && frames_ - last_look_ >= options_.face_relook);
+  if (look) last_look_ = frames_;
   ++frames_;
   // The cascade sees the frame halved until it is at most 320 pixels wide.
   int halvings = 0;
@@ -427,7 +433,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   const std::vector<RegionStats> stats = LabelRegions(out.skin, &out.labels);
   // What the set-aside shapes leave of a head or neck (the edge of a wider neck, a cheek):
   // regions lying almost wholly within a fifth of a face's width of them, unless they hold
-  // skin in front of a face or lie beside such a region.
+  // skin in front of a face, lie beside such a region or are of a hand's size.
   std::vector<int> near_face;  // by label: its pixels in the zone (empty without faces)
   std::vector<uint8_t> before_face;  // by label: it holds skin in front of a face
   if (!faces_.empty()) {
@@ -484,12 +490,16 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       for (size_t label = 1; label < stats.size(); ++label) body[label] |= piece(static_cast<int>(label));
     }
   }
+  // A leftover is a sliver: a region of a hand's size beside a face (kInFrontShare of the
+  // smallest face's box) is no cheek.
+  int least_hand = work.cols * work.rows;
+  for (const cv::Rect& face : faces_) least_hand = std::min(least_hand, static_cast<int>(kInFrontShare * working_box(face).area()));
   const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
   for (size_t label = 1; label < stats.size(); ++label) {
     const RegionStats& found = stats[label];
     if (found.area < min_area) continue;
     if (!near_face.empty() && before_face[label] == 0 && near_face[label] >= 0.8 * found.area &&
-        !beside_front(found.box)) {
+        found.area < least_hand && !beside_front(found.box)) {
       out.face_pixels += found.area * scale * scale;
       continue;
     }

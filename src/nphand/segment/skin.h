@@ -53,6 +53,10 @@ struct SkinOptions {
   // set aside from the skin.
   std::string face_cascade = kDefaultFaceCascade;
   int face_interval = 30;
+  // While the hand found last lies half or more within a face's box, the face is looked for
+  // again every face_relook frames: its box was found before the hand came over it, and
+  // followed since by a look the hand now shares.
+  int face_relook = 5;
   // A hand held in front of a face: of the skin within a face's head, the pieces that the
   // frame's edges (Canny on grey) part from the skin at the face's centre, if not much
   // smaller than a hand, are something in front of the face and stay skin; the rest, and
@@ -107,7 +111,8 @@ class SkinSegmenter {
   // Throws nphand::Error unless `bgr` is a non-empty 8-bit 3-channel image. `hand`: where
   // the hand was just found (frame pixels; empty: nowhere). The cascade takes a fist for a
   // face at times: on a look that a newcomer fired (the hand's own region changing shape),
-  // a face found where the hand was (most of each box within the other) is ignored. The
+  // or the hand over a face (face_relook), a face found where the hand was (most of each
+  // box within the other) is ignored. The
   // looks of every face_interval frames believe the cascade, so that a track on a face
   // lets go of it.
   SkinSegmentation Segment(const cv::Mat& bgr, cv::Rect hand = {});
@@ -130,6 +135,7 @@ class SkinSegmenter {
   int frames_ = 0;
   std::vector<cv::Rect> face_sized_;  // the last frame's regions that could hold a face
   bool newcomer_ = false;             // one of them met none of the frame before's
+  int last_look_ = 0;                 // the frame the cascade last ran on
   std::vector<cv::Rect> faces_;
   std::vector<cv::Mat> face_looks_;  // by face: its grey pixels where last seen, kFollowSide wide
   static constexpr int kFollowSide = 24;
