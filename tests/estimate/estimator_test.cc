@@ -342,6 +342,29 @@ TEST(CarriedOrderTest, ApartTheBestOfEachModeIsCarried) {
   EXPECT_EQ(CarriedOrder(poses, {}, 3, 0.5), (std::vector<size_t>{}));
 }
 
+// Regions rank by area, then nearer the last hand, then nearer its size. A sweater's region
+// four times the last hand's, a little farther than the hand's own, no longer comes first.
+TEST(CandidateScoreTest, TheLastHandsPlaceAndSizeRankTheRegions) {
+  const cv::Size frame(640, 480);  // 0.2 of its diagonal: 160 pixels
+  auto region = [](int area, cv::Point2d centroid) {
+    SkinRegion r;
+    r.area = area;
+    r.centroid = centroid;
+    return r;
+  };
+  const SkinRegion hand = region(5000, {250, 200}), body = region(20000, {200, 420});
+  EXPECT_DOUBLE_EQ(CandidateScore(hand, frame, cv::Rect(), 0), 5000.0);
+  const cv::Rect last(210, 140, 80, 120);  // centred at (250, 200)
+  EXPECT_DOUBLE_EQ(CandidateScore(hand, frame, last, 0), 5000.0);
+  // The place alone: the body's 226 pixels from the last hand leave 0.37 of it, 7,400 > 5,000.
+  EXPECT_GT(CandidateScore(body, frame, last, 0), CandidateScore(hand, frame, last, 0));
+  // With the last hand's size: four times it is two octaves off, 0.61 of the score.
+  EXPECT_DOUBLE_EQ(CandidateScore(hand, frame, last, 5000), 5000.0);
+  EXPECT_NEAR(CandidateScore(body, frame, last, 5000) / CandidateScore(body, frame, last, 0), std::exp(-0.5), 1e-12);
+  EXPECT_NEAR(CandidateScore(region(1250, {250, 200}), frame, last, 5000), 1250.0 * std::exp(-0.5), 1e-9);
+  EXPECT_LT(CandidateScore(body, frame, last, 5000), CandidateScore(hand, frame, last, 5000));
+}
+
 TEST(CombineWithPriorTest, WeightsAreNormalisedAndTwoModesSurviveUntilTheObservationSeparatesThem) {
   PoseX a = PoseX::Zero(), b = PoseX::Zero();
   b[9] = 2.0;  // far apart in pose space

@@ -228,6 +228,20 @@ double ModelHandLength(const Database& db) {
   NPHAND_THROW("the database holds no entry with a hand");
 }
 
+double CandidateScore(const SkinRegion& region, cv::Size frame, cv::Rect last_box, int last_area) {
+  double score = region.area;
+  if (last_box.area() > 0) {
+    const double spread = 0.2 * std::hypot(frame.width, frame.height);
+    const cv::Point2d d = region.centroid - cv::Point2d(last_box.x + 0.5 * last_box.width, last_box.y + 0.5 * last_box.height);
+    score *= std::exp(-(d.x * d.x + d.y * d.y) / (2.0 * spread * spread));
+  }
+  if (last_area > 0) {
+    const double two_octaves = std::log2(static_cast<double>(region.area) / last_area) / 2.0;
+    score *= std::exp(-0.5 * two_octaves * two_octaves);
+  }
+  return score;
+}
+
 Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel& hand, const EstimatorOptions& options)
     : db_(db),
       index_(index),
@@ -462,17 +476,8 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
     }
     candidates.push_back(&r);
   }
-  // Larger and nearer the last hand first.
-  const double spread = 0.2 * std::hypot(bgr.cols, bgr.rows);
-  const cv::Point2d last_centre(last_box_.x + 0.5 * last_box_.width, last_box_.y + 0.5 * last_box_.height);
-  auto score = [&](const SkinRegion* r) {
-    double s = r->area;
-    if (last_box_.area() > 0) {
-      const cv::Point2d d = r->centroid - last_centre;
-      s *= std::exp(-(d.x * d.x + d.y * d.y) / (2.0 * spread * spread));
-    }
-    return s;
-  };
+  // Larger, nearer the last hand and nearer its size first.
+  auto score = [&](const SkinRegion* r) { return CandidateScore(*r, bgr.size(), last_box_, last_area); };
   std::stable_sort(candidates.begin(), candidates.end(),
                    [&](const SkinRegion* a, const SkinRegion* b) { return score(a) > score(b); });
   result.ms.segment = Ms(start, Clock::now());

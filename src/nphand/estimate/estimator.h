@@ -221,6 +221,13 @@ std::vector<double> CombineWithPrior(const std::vector<PoseX>& poses, const std:
                                      const std::vector<WeightedPose>& carried, const EstimatorOptions& options,
                                      bool* prior_used);
 
+// How a skin region of `frame` ranks as the hand: its area, times a Gaussian of its
+// centroid's distance from the last hand's box's centre (0.2 of the frame's diagonal) and
+// one of its area's ratio to the last hand's (two octaves): the larger, nearer and more
+// like the last hand's size, the sooner it is looked up. Without a last box (empty) or
+// area (0) that factor is left out.
+double CandidateScore(const SkinRegion& region, cv::Size frame, cv::Rect last_box, int last_area);
+
 // The length of the database's hand from the wrist to the middle fingertip along its
 // bones (metres); throws nphand::Error for a database without a hand.
 double ModelHandLength(const Database& db);
