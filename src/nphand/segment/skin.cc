@@ -278,10 +278,10 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   // Faces: looked for every face_interval frames, at once when a region that could hold
   // one came into view on the last frame (someone came in; a hand split by its object, or
   // moving, is not new), and every face_relook frames while the hand is over a face's box;
-  // the cascade costs more than the rest of the frame. Between looks
-  // each face found is followed, as the camera moves. A face's skin (the head's ellipse and
-  // the neck below it) is set aside before the regions are found, so that a hand in front
-  // of a face keeps the rest of itself.
+  // the cascade costs more than the rest of the frame. Between looks each face found is
+  // followed, as the camera moves. A face's skin (the head's ellipse and the neck below it)
+  // is set aside before the regions are found, so that a hand in front of a face keeps the
+  // rest of itself.
   const bool periodic = frames_ % options_.face_interval == 0;
   const bool hand_over_face = hand.area() > 0 && std::any_of(faces_.begin(), faces_.end(), [&](const cv::Rect& face) {
     return 2 * (face & hand).area() >= hand.area();

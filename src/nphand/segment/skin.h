@@ -112,9 +112,8 @@ class SkinSegmenter {
   // the hand was just found (frame pixels; empty: nowhere). The cascade takes a fist for a
   // face at times: on a look that a newcomer fired (the hand's own region changing shape),
   // or the hand over a face (face_relook), a face found where the hand was (most of each
-  // box within the other) is ignored. The
-  // looks of every face_interval frames believe the cascade, so that a track on a face
-  // lets go of it.
+  // box within the other) is ignored. The looks of every face_interval frames believe the
+  // cascade, so that a track on a face lets go of it.
   SkinSegmentation Segment(const cv::Mat& bgr, cv::Rect hand = {});
 
   // Learns the hand's colours from a confidently estimated frame: `hand` (CV_8UC1 of the
