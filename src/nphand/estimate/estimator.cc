@@ -476,10 +476,11 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
     }
     candidates.push_back(&r);
   }
-  // Larger, nearer the last hand and nearer its size first.
-  auto score = [&](const SkinRegion* r) { return CandidateScore(*r, bgr.size(), last_box_, last_area); };
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [&](const SkinRegion* a, const SkinRegion* b) { return score(a) > score(b); });
+  // Larger, nearer the last hand and nearer its size first (each scored once).
+  std::vector<std::pair<double, const SkinRegion*>> ranked;
+  for (const SkinRegion* r : candidates) ranked.emplace_back(CandidateScore(*r, bgr.size(), last_box_, last_area), r);
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (size_t i = 0; i < ranked.size(); ++i) candidates[i] = ranked[i].second;
   result.ms.segment = Ms(start, Clock::now());
   if (candidates.empty()) {
     result.status = FrameStatus::kNoSkin;

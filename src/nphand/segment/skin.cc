@@ -406,8 +406,11 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     return bounds & whole;
   };
   // Skin a face's outline parts from it (a hand in front of it), working pixels: pieces of
-  // at least kInFrontShare of the face's box (a hand near a face is about as large as it),
-  // or going on outside the heads and necks.
+  // at least least_hand, kInFrontShare of the smallest face's box (a hand near a face is
+  // about as large as it), or going on outside the heads and necks.
+  int smallest_face = work.cols * work.rows;
+  for (const cv::Rect& face : faces_) smallest_face = std::min(smallest_face, working_box(face).area());
+  const double least_hand = kInFrontShare * smallest_face;
   cv::Mat in_front;
   if (!faces_.empty()) {
     cv::Mat face_mask = cv::Mat::zeros(work.size(), CV_8UC1);
@@ -417,13 +420,11 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       cv::Mat heads = cv::Mat::zeros(work.size(), CV_8UC1);
       const cv::Rect bounds = draw_faces(0.0, false, &heads);
       std::vector<cv::Rect> centres;
-      int smallest = work.cols * work.rows;
       for (const cv::Rect& face : faces_) {
         const cv::Rect f = working_box(face);
         centres.emplace_back(f.x + f.width / 4, f.y + f.height / 4, f.width / 2, f.height / 2);
-        smallest = std::min(smallest, f.area());
       }
-      in_front = InFrontOfFaces(work, out.skin, heads, face_mask, bounds, centres, kInFrontShare * smallest);
+      in_front = InFrontOfFaces(work, out.skin, heads, face_mask, bounds, centres, least_hand);
       face_mask &= ~in_front;
     }
     out.face_pixels = cv::countNonZero(out.skin & face_mask) * scale * scale;
@@ -433,7 +434,8 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   const std::vector<RegionStats> stats = LabelRegions(out.skin, &out.labels);
   // What the set-aside shapes leave of a head or neck (the edge of a wider neck, a cheek):
   // regions lying almost wholly within a fifth of a face's width of them, unless they hold
-  // skin in front of a face, lie beside such a region or are of a hand's size.
+  // skin in front of a face, lie beside such a region or are of a hand's size (least_hand):
+  // a leftover is a sliver.
   std::vector<int> near_face;  // by label: its pixels in the zone (empty without faces)
   std::vector<uint8_t> before_face;  // by label: it holds skin in front of a face
   if (!faces_.empty()) {
@@ -490,10 +492,6 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       for (size_t label = 1; label < stats.size(); ++label) body[label] |= piece(static_cast<int>(label));
     }
   }
-  // A leftover is a sliver: a region of a hand's size beside a face (kInFrontShare of the
-  // smallest face's box) is no cheek.
-  int least_hand = work.cols * work.rows;
-  for (const cv::Rect& face : faces_) least_hand = std::min(least_hand, static_cast<int>(kInFrontShare * working_box(face).area()));
   const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
   for (size_t label = 1; label < stats.size(); ++label) {
     const RegionStats& found = stats[label];
