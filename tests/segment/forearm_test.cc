@@ -107,6 +107,35 @@ TEST(ForearmTest, AnArmLeavingTheFrameObliquelyIsCut) {
             0.1 * cv::countNonZero(labels == static_cast<int>(PixelLabel::kForearm)));
 }
 
+TEST(ForearmTest, AnArmWideningAlongTheEdgesCutIsReadFromBeyondIt) {
+  // An arm that leaves by the bottom edge at a shallow slant, its hand holding a ball: the
+  // edge cuts the arm over a long stretch, along which the slices widen from nothing by
+  // more than the hand widens the arm, so read from the end the widening is the edge's and
+  // the arm no arm. Read from beyond the edge's stretch, the arm is cut at the wrist. The
+  // cut is given the skin region, as the estimator gives it.
+  SequenceOptions options;
+  options.grasp = 11;
+  options.face = true;
+  options.seed = 7201;
+  Sequence sequence(testing::RightHand(), options);
+  const SequenceFrame frame = sequence.Render(5);
+  SkinSegmenter segmenter;
+  const SkinSegmentation s = segmenter.Segment(frame.rgb);
+  const cv::Mat hand_label = frame.labels == static_cast<int>(PixelLabel::kHand);
+  const cv::Mat arm_label = frame.labels == static_cast<int>(PixelLabel::kForearm);
+  const SkinRegion* on_hand = nullptr;
+  for (const SkinRegion& region : s.regions) {
+    if (cv::countNonZero(hand_label(region.box)) > 0 && (on_hand == nullptr || region.area > on_hand->area)) on_hand = &region;
+  }
+  ASSERT_NE(on_hand, nullptr);
+  ASSERT_EQ(Border(on_hand->box, frame.rgb.size()), 8) << "the arm leaves by the bottom edge";
+  const ForearmCut c = CutForearm(s.RegionMask(*on_hand), Border(on_hand->box, frame.rgb.size()));
+  ASSERT_TRUE(c.cut);
+  const cv::Mat hand = hand_label(on_hand->box), arm = arm_label(on_hand->box);
+  EXPECT_GT(cv::countNonZero(c.hand & hand), 0.9 * cv::countNonZero(hand));
+  EXPECT_LT(cv::countNonZero(c.hand & arm), 0.1 * cv::countNonZero(arm));
+}
+
 TEST(ForearmTest, AnArmWideningTowardsTheHandIsCutNearTheWrist) {
   // An arm seen in perspective, its near end (the wrist) wider than its far, rounded end,
   // which does not reach the frame's edge: its narrowest slices are at the far end, yet

@@ -54,24 +54,67 @@ struct Frame {
   double S(int x, int y) const { return (x - centre.x) * across.x + (y - centre.y) * across.y; }
 };
 
-// Which sides of the slice at one end touch the frame: counts of the end's pixels (t within
-// [from, to]) that lie on a bordering edge.
-int EndTouches(const std::vector<MaskRun>& runs, const Frame& f, double from, double to, int border, const cv::Size& size) {
-  int touches = 0;
-  auto count = [&](int x, int y) {
-    const double t = f.T(x, y);
-    touches += t >= from && t <= to;
-  };
+// Calls `visit(x, y)` for each pixel of the region on a bordering edge of the frame.
+template <typename Visit>
+void ForEdgePixel(const std::vector<MaskRun>& runs, int border, const cv::Size& size, Visit visit) {
   for (const MaskRun& r : runs) {
     if (((border & 2) && r.y == 0) || ((border & 8) && r.y == size.height - 1)) {
-      for (int x = r.x0; x <= r.x1; ++x) count(x, r.y);
+      for (int x = r.x0; x <= r.x1; ++x) visit(x, r.y);
       continue;
     }
     const bool left = (border & 1) && r.x0 == 0, right = (border & 4) && r.x1 == size.width - 1;
-    if (left) count(r.x0, r.y);
-    if (right && !(left && r.x0 == r.x1)) count(r.x1, r.y);
+    if (left) visit(r.x0, r.y);
+    if (right && !(left && r.x0 == r.x1)) visit(r.x1, r.y);
   }
-  return touches;
+}
+
+// How the region meets the frame's edge at its two ends: counts of the edge pixels within
+// `reach` of each end, and how far along the axis from each end its contact with the edge
+// goes (the stretches of edge pixels, unbroken along a side of the frame, that begin within
+// `reach` of the end): an arm leaving the frame obliquely is cut by the edge over that
+// stretch, where its slices are not its width.
+struct EdgeContact {
+  int touch_low = 0, touch_high = 0;
+  double cap_low = 0.0, cap_high = 0.0;
+};
+
+EdgeContact ContactOf(const std::vector<MaskRun>& runs, const Frame& f, double t_min, double t_max, double reach, int border,
+                      const cv::Size& size) {
+  EdgeContact c;
+  ForEdgePixel(runs, border, size, [&](int x, int y) {
+    const double t = f.T(x, y);
+    c.touch_low += t <= t_min + reach;
+    c.touch_high += t >= t_max - reach;
+  });
+  // A stretch along the edge from (x0, y0) to (x1, y1): t is linear along it.
+  auto stretch = [&](int x0, int y0, int x1, int y1) {
+    const double a = f.T(x0, y0), b = f.T(x1, y1), low = std::min(a, b), high = std::max(a, b);
+    if (low <= t_min + reach) c.cap_low = std::max(c.cap_low, high - t_min);
+    if (high >= t_max - reach) c.cap_high = std::max(c.cap_high, t_max - low);
+  };
+  // Along the left and right sides: the runs that touch them on consecutive rows.
+  int left_from = -1, right_from = -1, last_left = -2, last_right = -2;
+  const int right_x = size.width - 1;
+  for (const MaskRun& r : runs) {
+    if (((border & 2) && r.y == 0) || ((border & 8) && r.y == size.height - 1)) stretch(r.x0, r.y, r.x1, r.y);
+    if ((border & 1) && r.x0 == 0) {
+      if (r.y != last_left + 1) {
+        if (left_from >= 0) stretch(0, left_from, 0, last_left);
+        left_from = r.y;
+      }
+      last_left = r.y;
+    }
+    if ((border & 4) && r.x1 == right_x) {
+      if (r.y != last_right + 1) {
+        if (right_from >= 0) stretch(right_x, right_from, right_x, last_right);
+        right_from = r.y;
+      }
+      last_right = r.y;
+    }
+  }
+  if (left_from >= 0) stretch(0, left_from, 0, last_left);
+  if (right_from >= 0) stretch(right_x, right_from, right_x, last_right);
+  return c;
 }
 
 }  // namespace
@@ -148,12 +191,13 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
   std::nth_element(sorted.begin(), sorted.begin() + percentile, sorted.end());
   const double widest = sorted[percentile];
   const double reach = 0.05 * slices;
-  const int touch_low = EndTouches(runs, f, t_min, t_min + reach, border, size);
-  const int touch_high = EndTouches(runs, f, t_max - reach, t_max, border, size);
+  const EdgeContact contact = ContactOf(runs, f, t_min, t_max, reach, border, size);
+  const int touch_low = contact.touch_low, touch_high = contact.touch_high;
 
   // From one end (direction +1: from t_min), the narrow stretch's end before the widening
-  // (steps from that end), or -1.
-  auto find_wrist = [&](int direction, double* wrist_width) {
+  // (steps from that end), or -1. `past_contact`: at the frame's edge, begin past the
+  // stretch the edge cuts (EdgeContact).
+  auto find_wrist = [&](int direction, bool past_contact, double* wrist_width) {
     auto index = [&](int step) { return direction > 0 ? step : slices - 1 - step; };
     // Skip the end's cap, where the width still grows: a rounded end, or an arm that leaves
     // the frame obliquely, whose cut edge can rise unevenly, so there the cap lasts until
@@ -162,6 +206,7 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
     int first = 0;
     while (first + 1 < slices && width[index(first + 1)] > 1.02 * width[index(first)]) ++first;
     if (at_edge) {
+      if (past_contact) first = std::max(first, static_cast<int>(std::ceil(direction > 0 ? contact.cap_low : contact.cap_high)));
       const int ahead = std::max(3, slices / 20);
       for (; first + ahead < slices; ++first) {
         std::vector<double> next;
@@ -209,8 +254,18 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
     return -1;
   };
   double width_low = 0.0, width_high = 0.0;
-  const int from_low = find_wrist(+1, &width_low);
-  const int from_high = find_wrist(-1, &width_high);
+  // The edge's stretch is skipped only where reading from the end finds no wrist: an arm
+  // that leaves the frame at a slant widens along that stretch as a hand does, but the
+  // stretch may also hold the wrist of a hand that meets the edge, or be a body's side (a
+  // third of the region or more: no arm's end).
+  auto from_end = [&](int direction, double* w) {
+    const int at = find_wrist(direction, false, w);
+    const double cap = direction > 0 ? contact.cap_low : contact.cap_high;
+    if (at >= 0 || cap < 1.0 || cap >= slices / 3.0) return at;
+    return find_wrist(direction, true, w);
+  };
+  const int from_low = from_end(+1, &width_low);
+  const int from_high = from_end(-1, &width_high);
   if (from_low >= 0 && from_high >= 0) {
     // Both ends could be an arm: the one entering from the frame's edge, else the longer run.
     if (touch_low != touch_high) {
