@@ -3,8 +3,10 @@
 // principal axis runs along the arm; its width profile along that axis is the arm's from
 // the elbow to the wrist and widens at the hand, so the cut goes through the narrowest point
 // just before the widening, across the axis (an arm seen in perspective tapers, so the
-// narrowest point of the whole arm may be its far end). A region without a forearm has no
-// such stretch and is left whole.
+// narrowest point of the whole arm may be its far end). An arm that leaves the frame at a
+// slant is cut by the frame's edge over a stretch whose slices widen from nothing: where
+// reading from its end finds no wrist, the profile is read again from beyond that stretch.
+// A region without a forearm has no narrow stretch before a widening and is left whole.
 #pragma once
 
 #include <string>
