@@ -54,20 +54,6 @@ struct Frame {
   double S(int x, int y) const { return (x - centre.x) * across.x + (y - centre.y) * across.y; }
 };
 
-// Calls `visit(x, y)` for each pixel of the region on a bordering edge of the frame.
-template <typename Visit>
-void ForEdgePixel(const std::vector<MaskRun>& runs, int border, const cv::Size& size, Visit visit) {
-  for (const MaskRun& r : runs) {
-    if (((border & 2) && r.y == 0) || ((border & 8) && r.y == size.height - 1)) {
-      for (int x = r.x0; x <= r.x1; ++x) visit(x, r.y);
-      continue;
-    }
-    const bool left = (border & 1) && r.x0 == 0, right = (border & 4) && r.x1 == size.width - 1;
-    if (left) visit(r.x0, r.y);
-    if (right && !(left && r.x0 == r.x1)) visit(r.x1, r.y);
-  }
-}
-
 // How the region meets the frame's edge at its two ends: counts of the edge pixels within
 // `reach` of each end, and how far along the axis from each end its contact with the edge
 // goes (the stretches of edge pixels, unbroken along a side of the frame, that begin within
@@ -81,39 +67,44 @@ struct EdgeContact {
 EdgeContact ContactOf(const std::vector<MaskRun>& runs, const Frame& f, double t_min, double t_max, double reach, int border,
                       const cv::Size& size) {
   EdgeContact c;
-  ForEdgePixel(runs, border, size, [&](int x, int y) {
+  auto touch = [&](int x, int y) {
     const double t = f.T(x, y);
     c.touch_low += t <= t_min + reach;
     c.touch_high += t >= t_max - reach;
-  });
+  };
   // A stretch along the edge from (x0, y0) to (x1, y1): t is linear along it.
   auto stretch = [&](int x0, int y0, int x1, int y1) {
     const double a = f.T(x0, y0), b = f.T(x1, y1), low = std::min(a, b), high = std::max(a, b);
     if (low <= t_min + reach) c.cap_low = std::max(c.cap_low, high - t_min);
     if (high >= t_max - reach) c.cap_high = std::max(c.cap_high, t_max - low);
   };
-  // Along the left and right sides: the runs that touch them on consecutive rows.
-  int left_from = -1, right_from = -1, last_left = -2, last_right = -2;
-  const int right_x = size.width - 1;
+  // Along the left and right sides a stretch is the rows, while consecutive, whose runs touch it.
+  struct Side {
+    int x, from = -1, last = -2;
+  };
+  auto extend = [&](Side& side, int y) {
+    if (y != side.last + 1) {
+      if (side.from >= 0) stretch(side.x, side.from, side.x, side.last);
+      side.from = y;
+    }
+    side.last = y;
+  };
+  Side left{0}, right{size.width - 1};
   for (const MaskRun& r : runs) {
-    if (((border & 2) && r.y == 0) || ((border & 8) && r.y == size.height - 1)) stretch(r.x0, r.y, r.x1, r.y);
-    if ((border & 1) && r.x0 == 0) {
-      if (r.y != last_left + 1) {
-        if (left_from >= 0) stretch(0, left_from, 0, last_left);
-        left_from = r.y;
-      }
-      last_left = r.y;
+    const bool at_left = (border & 1) && r.x0 == 0, at_right = (border & 4) && r.x1 == right.x;
+    if (((border & 2) && r.y == 0) || ((border & 8) && r.y == size.height - 1)) {
+      for (int x = r.x0; x <= r.x1; ++x) touch(x, r.y);
+      stretch(r.x0, r.y, r.x1, r.y);
+    } else {
+      if (at_left) touch(r.x0, r.y);
+      if (at_right && !(at_left && r.x0 == r.x1)) touch(r.x1, r.y);
     }
-    if ((border & 4) && r.x1 == right_x) {
-      if (r.y != last_right + 1) {
-        if (right_from >= 0) stretch(right_x, right_from, right_x, last_right);
-        right_from = r.y;
-      }
-      last_right = r.y;
-    }
+    if (at_left) extend(left, r.y);
+    if (at_right) extend(right, r.y);
   }
-  if (left_from >= 0) stretch(0, left_from, 0, last_left);
-  if (right_from >= 0) stretch(right_x, right_from, right_x, last_right);
+  for (const Side& side : {left, right}) {
+    if (side.from >= 0) stretch(side.x, side.from, side.x, side.last);
+  }
   return c;
 }
 
