@@ -11,6 +11,7 @@
 #include "nphand/segment/forearm.h"
 #include "nphand/segment/skin.h"
 #include "nphand/sequence/sequence.h"
+#include "nphand/util/check.h"
 #include "nphand/util/random.h"
 
 namespace nphand {
@@ -42,6 +43,27 @@ void BM_SkinSegment(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(segmenter.Segment(Frame().rgb).regions.size());
 }
 BENCHMARK(BM_SkinSegment)->ArgName("rim")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// A frame with a face in view, looked for once and followed since, without and with the face's
+// chroma gate (SkinOptions::face_chroma), which classifies the frame's skin a second time.
+void BM_SkinSegmentBesideAFace(benchmark::State& state) {
+  static const SequenceFrame frame = [] {
+    static const HandModel hand = HandModel::Load(Handedness::kRight);
+    SequenceOptions options;
+    options.background = BackgroundKind::kClutter;
+    options.face = true;
+    options.seed = 3;
+    Sequence sequence(hand, options);
+    return sequence.Render(options.frames / 2);
+  }();
+  SkinOptions options;
+  options.face_interval = 1000000;
+  options.face_chroma = state.range(0) == 0 ? 0.0 : SkinOptions{}.face_chroma;
+  SkinSegmenter segmenter(options);
+  NPHAND_THROW_CHECK(segmenter.Segment(frame.rgb).faces.size() == 1, "the benchmark's frame must show its face");
+  for (auto _ : state) benchmark::DoNotOptimize(segmenter.Segment(frame.rgb).regions.size());
+}
+BENCHMARK(BM_SkinSegmentBesideAFace)->ArgName("face_chroma")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 void BM_FaceCascade(benchmark::State& state) {
   SkinOptions options;

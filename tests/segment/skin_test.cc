@@ -467,6 +467,7 @@ TEST(SkinTest, ABodyInASkinColouredSweaterIsSetAsideAndTheHandStays) {
     auto segment = [&](bool set_aside_bodies, int* body_pixels) {
       SkinOptions skin;
       skin.set_aside_bodies = set_aside_bodies;
+      skin.face_chroma = 0.0;  // which shuts out the lighter sweaters on its own
       SkinSegmenter segmenter(skin);
       const SkinSegmentation s = segmenter.Segment(frame.rgb);
       EXPECT_EQ(s.faces.size(), 1u) << seed;
@@ -536,6 +537,53 @@ TEST(SkinTest, FlushedFingertipsJoinTheirHand) {
   EXPECT_LT(skin_in(s, tip), 0.01);
 }
 
+// A wall behind the person of a colour the fixed model takes for skin but far from the
+// face's own (a cream wall behind medium skin, a wooden one behind light skin): with a face in
+// view, the wall is no skin and the hand, shaded as it is, stays.
+TEST(SkinTest, AFacesOwnSkinShutsOutAWarmWallAndKeepsTheHand) {
+  for (const auto& [tone, wall_bgr] : {std::pair{"medium", cv::Scalar(175, 205, 225)}, std::pair{"light", cv::Scalar(60, 110, 170)}}) {
+    SequenceOptions options = testing::DemoSequence(12);
+    options.skin = tone;
+    Sequence sequence(testing::RightHand(), options);
+    const SequenceFrame frame = sequence.Render(60);
+    const cv::Mat hand = frame.labels == static_cast<int>(PixelLabel::kHand);
+    cv::Mat arm = hand | (frame.labels == static_cast<int>(PixelLabel::kForearm));
+    cv::dilate(arm, arm, cv::Mat(), cv::Point(-1, -1), 4);
+    SkinSegmenter looker;
+    const std::vector<cv::Rect> faces = looker.Segment(frame.rgb).faces;
+    ASSERT_EQ(faces.size(), 1u) << tone;
+    // The wall: the background of the upper three fifths of the frame's half away from the
+    // face (where the hand moves), a little noisy.
+    const cv::Rect face = faces[0];
+    const int half = frame.rgb.cols / 2;
+    cv::Mat wall = cv::Mat::zeros(frame.rgb.size(), CV_8UC1);
+    wall(cv::Rect(face.x + face.width / 2 < half ? half : 0, 0, half, frame.rgb.rows * 3 / 5)).setTo(255);
+    wall &= frame.labels == static_cast<int>(PixelLabel::kBackground);
+    cv::Mat painted(frame.rgb.size(), CV_8UC3, wall_bgr), noise(frame.rgb.size(), CV_8UC3);
+    cv::RNG rng(testing::kTestSeed);
+    rng.fill(noise, cv::RNG::NORMAL, cv::Scalar::all(0), cv::Scalar::all(3));
+    painted += noise;
+    cv::Mat with_wall = frame.rgb.clone();
+    painted.copyTo(with_wall, wall);
+    // The regions' pixels on the wall, and their share of the hand's pixels.
+    auto segment = [&](double face_chroma) {
+      SkinOptions skin;
+      skin.face_chroma = face_chroma;
+      SkinSegmenter segmenter(skin);
+      const SkinSegmentation s = segmenter.Segment(with_wall);
+      EXPECT_EQ(s.faces.size(), 1u) << tone;
+      const cv::Mat regions = Regions(s);
+      return std::pair{cv::countNonZero(regions & wall & ~arm), static_cast<double>(cv::countNonZero(regions & hand)) / cv::countNonZero(hand)};
+    };
+    const auto [on_wall, hand_share] = segment(SkinOptions{}.face_chroma);
+    const auto [on_wall_without, hand_share_without] = segment(0.0);
+    EXPECT_GT(on_wall_without, 0.3 * cv::countNonZero(wall)) << tone << ": the fixed model takes the wall";
+    EXPECT_LT(on_wall, 0.01 * on_wall_without) << tone;
+    EXPECT_GT(hand_share, 0.8) << tone;
+    EXPECT_GT(hand_share, 0.95 * hand_share_without) << tone;
+  }
+}
+
 TEST(SkinTest, BadInputIsRefused) {
   SkinSegmenter segmenter(NoFaces());
   testing::ExpectError([&] { segmenter.Segment(cv::Mat()); }, "8-bit BGR");
@@ -552,6 +600,9 @@ TEST(SkinTest, BadInputIsRefused) {
   options = NoFaces();
   options.work_width = 10;
   testing::ExpectError([&] { SkinSegmenter bad(options); }, "working width");
+  options = NoFaces();
+  options.face_chroma = -1.0;
+  testing::ExpectError([&] { SkinSegmenter bad(options); }, "face's chroma reach");
   options = SkinOptions{};
   options.face_cascade = "/nonexistent/cascade.xml";
   testing::ExpectError([&] { SkinSegmenter bad(options); }, "no face cascade");

@@ -35,6 +35,8 @@ bool SkinOptions::Check(std::string* why) const {
     *why = "skin morphology sizes must be within 0..31 pixels";
   } else if (!(min_area > 0.0 && min_area < 1.0)) {
     *why = "the smallest skin region must be within (0, 1) of the frame";
+  } else if (!(face_chroma >= 0.0 && face_chroma <= 10.0)) {
+    *why = "the face's chroma reach must be within 0..10 standard deviations";
   } else if (face_interval < 1 || face_relook < 1) {
     *why = "the face interval and relook must be at least 1 frame";
   } else if (work_width != 0 && work_width < 64) {
@@ -243,6 +245,46 @@ cv::Mat SkinSegmentation::Mask(const std::vector<int>& which, cv::Rect box) cons
   return large(cv::Rect(box.x - under.x * scale, box.y - under.y * scale, box.width, box.height)) >= 128;
 }
 
+std::optional<SkinSegmenter::FaceChroma> SkinSegmenter::FaceChromaOf(const cv::Mat& ycrcb,
+                                                                     const std::vector<cv::Rect>& faces) const {
+  // The skin-coloured pixels of each face's cheeks, nose and mouth (an ellipse within its
+  // box, below the eyes' line and short of the hair and the jaw's edge).
+  double n = 0.0, cr = 0.0, cb = 0.0, crcr = 0.0, crcb = 0.0, cbcb = 0.0;
+  for (const cv::Rect& face : faces) {
+    cv::Mat inner = cv::Mat::zeros(face.size(), CV_8UC1);
+    cv::ellipse(inner, cv::Point(face.width / 2, face.height * 11 / 20), cv::Size(face.width * 3 / 10, face.height * 7 / 20), 0,
+                0, 360, cv::Scalar(255), cv::FILLED);
+    const cv::Rect within = face & cv::Rect(0, 0, ycrcb.cols, ycrcb.rows);
+    for (int y = within.y; y < within.y + within.height; ++y) {
+      const cv::Vec3b* in = ycrcb.ptr<cv::Vec3b>(y);
+      const uint8_t* mark = inner.ptr<uint8_t>(y - face.y);
+      for (int x = within.x; x < within.x + within.width; ++x) {
+        if (mark[x - face.x] == 0 || in[x][0] < options_.y_min || lookup_.data[in[x][1] * 256 + in[x][2]] != kSkin) continue;
+        const double r = (in[x][1] - 128.0) / in[x][0], b = (in[x][2] - 128.0) / in[x][0];
+        n += 1.0;
+        cr += r;
+        cb += b;
+        crcr += r * r;
+        crcb += r * b;
+        cbcb += b * b;
+      }
+    }
+  }
+  if (n < kFaceChromaLeast) return std::nullopt;
+  FaceChroma chroma;
+  chroma.cr = cr / n;
+  chroma.cb = cb / n;
+  chroma.reach = options_.face_chroma * options_.face_chroma;
+  const double srr = crcr / n - chroma.cr * chroma.cr, srb = crcb / n - chroma.cr * chroma.cb, sbb = cbcb / n - chroma.cb * chroma.cb;
+  for (int y = std::max(options_.y_min, 1); y < 256; ++y) {
+    // A level of chroma is 1 / y of this measure: the floor widens dim pixels' reach more.
+    const double floor = (kFaceChromaFloor / y) * (kFaceChromaFloor / y);
+    const double rr = srr + floor, bb = sbb + floor, det = rr * bb - srb * srb;
+    chroma.inverse[y] = {bb / det, -srb / det, rr / det};
+  }
+  return chroma;
+}
+
 SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   NPHAND_THROW_CHECK(!bgr.empty() && bgr.type() == CV_8UC3, "skin: a frame must be a non-empty 8-bit BGR image");
   SkinSegmentation out;
@@ -251,29 +293,35 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   const int scale = out.scale;
   cv::Mat ycrcb;
   cv::cvtColor(work, ycrcb, cv::COLOR_BGR2YCrCb);
-  out.skin.create(work.size(), CV_8UC1);
-  cv::Mat rim(work.size(), CV_8UC1);
-  for (int y = 0; y < ycrcb.rows; ++y) {
-    const cv::Vec3b* in = ycrcb.ptr<cv::Vec3b>(y);
-    uint8_t* skin = out.skin.ptr<uint8_t>(y);
-    uint8_t* rim_row = rim.ptr<uint8_t>(y);
-    for (int x = 0; x < ycrcb.cols; ++x) {
-      const uint8_t kind = in[x][0] >= options_.y_min ? lookup_.at<uint8_t>(in[x][1], in[x][2]) : 0;
-      skin[x] = kind == kSkin ? 255 : 0;
-      rim_row[x] = kind == kRim ? 255 : 0;
-    }
-  }
-  if (options_.rim_area > 0.0) AddRim(static_cast<int>(options_.rim_area * work.total()), &rim, &out.skin);
   // A size in frame pixels at the working resolution: odd, so that the kernel is centred.
   auto working = [&](int px) { return ((px + scale - 1) / scale) | 1; };
-  if (options_.open_px > 1) {
-    const int k = working(options_.open_px);
-    cv::morphologyEx(out.skin, out.skin, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
-  }
-  if (options_.close_px > 1) {
-    const int k = working(options_.close_px);
-    cv::morphologyEx(out.skin, out.skin, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
-  }
+  // The skin (and its rim) by the colour model, within `face` where one is given, cleaned.
+  auto classify = [&](const FaceChroma* face) {
+    out.skin.create(work.size(), CV_8UC1);
+    cv::Mat rim(work.size(), CV_8UC1);
+    for (int y = 0; y < ycrcb.rows; ++y) {
+      const cv::Vec3b* in = ycrcb.ptr<cv::Vec3b>(y);
+      uint8_t* skin = out.skin.ptr<uint8_t>(y);
+      uint8_t* rim_row = rim.ptr<uint8_t>(y);
+      for (int x = 0; x < ycrcb.cols; ++x) {
+        const int at = in[x][1] * 256 + in[x][2];
+        const bool allowed = in[x][0] >= options_.y_min && (face == nullptr || face->Holds(in[x][0], in[x][1], in[x][2]));
+        const uint8_t kind = allowed ? lookup_.data[at] : 0;
+        skin[x] = kind == kSkin ? 255 : 0;
+        rim_row[x] = kind == kRim ? 255 : 0;
+      }
+    }
+    if (options_.rim_area > 0.0) AddRim(static_cast<int>(options_.rim_area * work.total()), &rim, &out.skin);
+    if (options_.open_px > 1) {
+      const int k = working(options_.open_px);
+      cv::morphologyEx(out.skin, out.skin, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
+    }
+    if (options_.close_px > 1) {
+      const int k = working(options_.close_px);
+      cv::morphologyEx(out.skin, out.skin, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
+    }
+  };
+  classify(nullptr);
 
   // Faces: looked for every face_interval frames, at once when a region that could hold
   // one came into view on the last frame (someone came in; a hand split by its object, or
@@ -386,6 +434,17 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     for (size_t i = 0; i < faces_.size(); ++i) follow(i);
   }
   out.faces = faces_;
+  // The faces' own skin tells the person's: the skin is found again within the colours near
+  // it, which a warm wall, blonde hair or a cream sweater that the fixed model takes lie
+  // outside of.
+  if (options_.face_chroma > 0.0 && !faces_.empty()) {
+    const std::optional<FaceChroma> face = FaceChromaOf(ycrcb, [&] {
+      std::vector<cv::Rect> boxes;
+      for (const cv::Rect& box : faces_) boxes.push_back(working_box(box));
+      return boxes;
+    }());
+    if (face) classify(&*face);
+  }
   // Each face's head (an ellipse about its box) and, with `necks`, neck (a rectangle
   // below), grown by `grow` faces' widths, drawn into `mask` (working pixels); returns their
   // bounds.

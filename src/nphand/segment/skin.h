@@ -5,6 +5,7 @@
 // found by OpenCV's Haar cascade (Debian's opencv-data) and their skin set aside.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -67,6 +68,12 @@ struct SkinOptions {
   // and at most kBodyHeight times as tall as that, and together span at least kBodyWidths
   // face widths, are set aside as no hand.
   bool set_aside_bodies = true;
+  // The person's own skin: while a face is in view, skin is only the colour within
+  // face_chroma standard deviations (Mahalanobis) of its cheeks' pixels, over the chroma
+  // divided by the brightness ((Cr - 128) / Y, (Cb - 128) / Y: a shadow dims skin, and its
+  // chroma with it, without changing this), their spread widened by kFaceChromaFloor levels
+  // of chroma each way (0: the fixed and learned models alone).
+  double face_chroma = 3.0;
   bool Check(std::string* why) const;
 };
 
@@ -125,6 +132,22 @@ class SkinSegmenter {
 
  private:
   void RebuildLookup();
+  // The colours of the faces' skin (SkinOptions::face_chroma): per brightness Y, the
+  // inverse spread over ((Cr - 128) / Y, (Cb - 128) / Y) widened by kFaceChromaFloor / Y.
+  struct FaceChroma {
+    double cr = 0.0, cb = 0.0;                          // the mean
+    std::array<std::array<double, 3>, 256> inverse{};  // per Y: (rr, rb, bb) of the inverse spread
+    double reach = 0.0;                                 // squared Mahalanobis distance allowed
+    bool Holds(int y, int cr_level, int cb_level) const {
+      if (y == 0) return false;
+      const double r = (cr_level - 128.0) / y - cr, b = (cb_level - 128.0) / y - cb;
+      const std::array<double, 3>& m = inverse[y];
+      return m[0] * r * r + 2.0 * m[1] * r * b + m[2] * b * b <= reach;
+    }
+  };
+  // From `ycrcb` (the working frame) and the faces' boxes in its pixels; nullopt when the
+  // faces show too little skin to tell.
+  std::optional<FaceChroma> FaceChromaOf(const cv::Mat& ycrcb, const std::vector<cv::Rect>& faces) const;
 
   SkinOptions options_;
   static constexpr uint8_t kSkin = 255, kRim = 128;
@@ -142,6 +165,8 @@ class SkinSegmenter {
   static constexpr double kInFrontShare = 0.15;  // least piece in front of a face, of its box
   static constexpr double kBodyWidths = 1.25;    // a body's least span along the frame's bottom edge, in faces
   static constexpr double kBodyPiece = 0.25;     // a body's piece's least width along that edge, in faces
+  static constexpr double kFaceChromaLeast = 30;  // working pixels of a face's skin that tell its chroma
+  static constexpr double kFaceChromaFloor = 6.0;  // levels of chroma added to its spread each way
   static constexpr double kBodyHeight = 3.0;     // a body's piece's greatest height, in its width along that edge (an arm is taller)
   struct FaceDetector;
   std::shared_ptr<FaceDetector> detector_;
