@@ -304,9 +304,8 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       uint8_t* skin = out.skin.ptr<uint8_t>(y);
       uint8_t* rim_row = rim.ptr<uint8_t>(y);
       for (int x = 0; x < ycrcb.cols; ++x) {
-        const int at = in[x][1] * 256 + in[x][2];
-        const bool allowed = in[x][0] >= options_.y_min && (face == nullptr || face->Holds(in[x][0], in[x][1], in[x][2]));
-        const uint8_t kind = allowed ? lookup_.data[at] : 0;
+        uint8_t kind = in[x][0] >= options_.y_min ? lookup_.data[in[x][1] * 256 + in[x][2]] : 0;
+        if (kind != 0 && face != nullptr && !face->Holds(in[x][0], in[x][1], in[x][2])) kind = 0;
         skin[x] = kind == kSkin ? 255 : 0;
         rim_row[x] = kind == kRim ? 255 : 0;
       }
