@@ -131,6 +131,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   estimator_options.track_views = options.track_views;
   estimator_options.carried = options.carried;
   estimator_options.carry_apart_frames = options.carry_apart_frames;
+  estimator_options.skin.face_chroma = options.face_chroma;
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, index, hand, estimator_options);
@@ -153,6 +154,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["track_views"] = options.track_views;
   result.figures["carried"] = options.carried;
   result.figures["carry_apart_frames"] = options.carry_apart_frames;
+  result.figures["face_chroma"] = options.face_chroma;
   result.figures["given_box"] = options.given_box;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {

@@ -217,6 +217,9 @@ TEST_F(EstimateCommandTest, BadInputsGiveTheirErrors) {
   options = Options();
   options.prior = "max";
   testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "none, product or sum");
+  options = Options();
+  options.estimator.skin.face_chroma = 12.0;
+  testing::ExpectError([&] { RunEstimate(options, nullptr, nullptr); }, "face's chroma reach must be within 0..10");
   // Truth and poses that do not belong together.
   {
     std::ofstream broken(*dir_ / "broken.jsonl");
@@ -357,6 +360,12 @@ TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles
   EXPECT_EQ(RunEvalReal(views, nullptr).figures["track_views"], 0);
   views.track_views = 65;
   testing::ExpectError([&] { RunEvalReal(views, nullptr); }, "track's views");
+  // --face-chroma: reported; beyond 10 standard deviations refused.
+  EvalRealCommandOptions ungated = boxed;
+  ungated.face_chroma = 0.0;
+  EXPECT_EQ(RunEvalReal(ungated, nullptr).figures["face_chroma"], 0.0);
+  ungated.face_chroma = 11.0;
+  testing::ExpectError([&] { RunEvalReal(ungated, nullptr); }, "face's chroma reach");
   // --max-distance: so strict that no view is near enough, every hand is missed.
   EvalRealCommandOptions strict = refined;
   strict.refine = false;
