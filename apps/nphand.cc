@@ -40,6 +40,11 @@ std::string CommaList(const std::vector<std::string>& names) {
   return list;
 }
 
+// --face-chroma of estimate and eval real (SkinOptions::face_chroma).
+constexpr const char* kFaceChromaHelp =
+    "While a face is in view, skin is only the colours within this many standard deviations of its cheeks' "
+    "(0: off, as when someone else's face is behind the hand)";
+
 // For options held in unsigned fields, which would take "-1" as a huge number.
 CLI::Validator WholeNumber() {
   return CLI::Validator(
@@ -206,10 +211,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--fov", e.fov_deg, "Horizontal field of view, degrees")->capture_default_str();
   cmd->add_option("--hand-length", e.hand_length_m, "Wrist to middle fingertip, metres")->capture_default_str();
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
-  cmd->add_option("--face-chroma", e.skin.face_chroma,
-                  "While a face is in view, skin is only the colours within this many standard deviations of its cheeks' "
-                  "(0: off, as when someone else's face is behind the hand)")
-      ->capture_default_str();
+  cmd->add_option("--face-chroma", e.skin.face_chroma, kFaceChromaHelp)->capture_default_str();
   cmd->add_flag("!--no-forearm-cut", e.cut_forearm, "Do not cut the forearm at the wrist");
   cmd->add_option("--roi", o.roi, "x,y,width,height: seek the hand in this part of the frame only (skin elsewhere is ignored)")
       ->delimiter(',')
@@ -472,9 +474,7 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
                   "In a track's first N frames, carry hypotheses at least sigma_x apart in pose (one per mode; 0: never)")
       ->check(WholeNumber())
       ->capture_default_str();
-  cmd->add_option("--face-chroma", o.face_chroma,
-                  "While a face is in view, skin is only the colours within this many standard deviations of its cheeks' (0: off)")
-      ->capture_default_str();
+  cmd->add_option("--face-chroma", o.face_chroma, kFaceChromaHelp)->capture_default_str();
   cmd->add_flag("--given-box", o.given_box,
                 "The hand's place given: each labelled hand estimated within its box grown by 25 % (its pose judged alone)");
   cmd->add_option("--hand", o.hand, "given (each labelled side searched for) or auto (the estimator chooses, and is scored)")

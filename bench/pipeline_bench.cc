@@ -17,16 +17,19 @@
 namespace nphand {
 namespace {
 
-const SequenceFrame& Frame() {
-  static const SequenceFrame frame = [] {
+// A camera-like frame midway through a rendered sequence, with a face beside the hand or not.
+const SequenceFrame& Frame(bool face = false) {
+  auto render = [](bool with_face) {
     static const HandModel hand = HandModel::Load(Handedness::kRight);
     SequenceOptions options;
     options.background = BackgroundKind::kClutter;
+    options.face = with_face;
     options.seed = 3;
     Sequence sequence(hand, options);
     return sequence.Render(options.frames / 2);
-  }();
-  return frame;
+  };
+  static const SequenceFrame without = render(false), with = render(true);
+  return face ? with : without;
 }
 
 SkinOptions NoFaces() {
@@ -47,15 +50,7 @@ BENCHMARK(BM_SkinSegment)->ArgName("rim")->Arg(0)->Arg(1)->Unit(benchmark::kMicr
 // A frame with a face in view, looked for once and followed since, without and with the face's
 // chroma gate (SkinOptions::face_chroma), which classifies the frame's skin a second time.
 void BM_SkinSegmentBesideAFace(benchmark::State& state) {
-  static const SequenceFrame frame = [] {
-    static const HandModel hand = HandModel::Load(Handedness::kRight);
-    SequenceOptions options;
-    options.background = BackgroundKind::kClutter;
-    options.face = true;
-    options.seed = 3;
-    Sequence sequence(hand, options);
-    return sequence.Render(options.frames / 2);
-  }();
+  const SequenceFrame& frame = Frame(true);
   SkinOptions options;
   options.face_interval = 1000000;
   options.face_chroma = state.range(0) == 0 ? 0.0 : SkinOptions{}.face_chroma;
