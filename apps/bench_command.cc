@@ -96,6 +96,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
       s.width = options.width;
       s.height = options.height;
       s.seed = options.seed + static_cast<uint64_t>(i / kPerSequence);
+      s.face = options.face;
       sequence.emplace(hand, s);
       estimator.Reset();
     }
@@ -128,6 +129,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
       {"k", options.k},
       {"track_views", options.track_views},
       {"refine", options.refine},
+      {"face", options.face},
       {"hand", options.hand},
       {"peak_rss_mb", PeakRssMb()},
       {"rss_after_load_mb", rss_loaded},

@@ -39,6 +39,9 @@ struct BenchPipelineOptions : EstimatorFiles {
   int track_views = EstimatorOptions{}.track_views;  // viewpoints of the track's views measured besides
   std::string hand = "right";   // right, left or auto
   bool refine = false;          // the estimator refines its best view (refine/refiner.h)
+  // A face beside the hand in every frame, as before a webcam: the face cascade and the
+  // skin gate read from the face are then part of the time.
+  bool face = true;
   uint64_t seed = 1;
   // OpenCV's threads for the image work (colour, resizing, morphology, the face cascade);
   // 1 keeps the whole path on one core, as the speed goal asks.

@@ -255,6 +255,8 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
       ->capture_default_str();
   pipeline->add_option("--hand", p.hand, "right, left or auto (both sides searched)")->capture_default_str();
   pipeline->add_flag("--refine", p.refine, "Refine the best view's pose (its cost is ms.refine)");
+  pipeline->add_flag("--face,!--no-face", p.face, "A face beside the hand in every frame (the face cascade and its skin gate timed too)")
+      ->capture_default_str();
   pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->check(WholeNumber())->capture_default_str();
   pipeline->add_option("--threads", p.threads, "OpenCV threads for the image work (1: one core)")->capture_default_str();
   pipeline->add_flag("--json", json, "Print one JSON object");

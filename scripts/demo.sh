@@ -47,7 +47,7 @@ echo "demo: nearest-neighbour study (paper Fig. 5) on 100 held-out renders, exac
 
 echo "demo: renderer speed (label images of 128x128, hand + object, one core)"
 "$nphand" bench render --json | tee "$out/bench_render.json"
-echo "demo: the whole estimator's speed (640x480 frames, K = 500, one core)"
+echo "demo: the whole estimator's speed (640x480 frames with a face beside the hand, K = 500, one core)"
 "$nphand" bench pipeline --json | tee "$out/bench_pipeline.json"
 
 echo "demo: a rendered sequence: a hand with a bare forearm closing onto a cylinder 0.8 times the database's, a rolling camera"

@@ -426,6 +426,7 @@ TEST_F(EstimateCommandTest, BenchPipelineReportsEveryFigure) {
     EXPECT_TRUE(report["ms"].contains(stage)) << stage;
   }
   EXPECT_EQ(report["refine"], false);
+  EXPECT_EQ(report["face"], true) << "a face beside the hand by default, as before a webcam";
   EXPECT_EQ(report["ms"]["refine"]["median"], 0.0) << "no refinement, no time";
   EXPECT_EQ(report["backend"], "exact");
   EXPECT_GT(report["fps"].get<double>(), 0.0);
@@ -433,8 +434,10 @@ TEST_F(EstimateCommandTest, BenchPipelineReportsEveryFigure) {
   EXPECT_EQ(report["threads"], 1);
   EXPECT_EQ(cv::getNumThreads(), threads_before);
   options.refine = true;
+  options.face = false;
   const nlohmann::json refined = RunBenchPipeline(options);
   EXPECT_EQ(refined["refine"], true);
+  EXPECT_EQ(refined["face"], false);
   ASSERT_GT(refined["detected"].get<int>(), 0);
   EXPECT_GT(refined["ms"]["refine"]["mean"].get<double>(), 0.0);
   options.threads = 0;
