@@ -272,15 +272,14 @@ std::optional<SkinSegmenter::FaceChroma> SkinSegmenter::FaceChromaOf(const cv::M
   }
   if (n < kFaceChromaLeast) return std::nullopt;
   FaceChroma chroma;
-  chroma.cr = cr / n;
-  chroma.cb = cb / n;
+  const double mean_cr = cr / n, mean_cb = cb / n;
   chroma.reach = options_.face_chroma * options_.face_chroma;
-  const double srr = crcr / n - chroma.cr * chroma.cr, srb = crcb / n - chroma.cr * chroma.cb, sbb = cbcb / n - chroma.cb * chroma.cb;
+  const double srr = crcr / n - mean_cr * mean_cr, srb = crcb / n - mean_cr * mean_cb, sbb = cbcb / n - mean_cb * mean_cb;
   for (int y = std::max(options_.y_min, 1); y < 256; ++y) {
     // A level of chroma is 1 / y of this measure: the floor widens dim pixels' reach more.
     const double floor = (kFaceChromaFloor / y) * (kFaceChromaFloor / y);
-    const double rr = srr + floor, bb = sbb + floor, det = rr * bb - srb * srb;
-    chroma.inverse[y] = {bb / det, -srb / det, rr / det};
+    const double rr = srr + floor, bb = sbb + floor, det = (rr * bb - srb * srb) * y * y;
+    chroma.levels[y] = {mean_cr * y, mean_cb * y, bb / det, -srb / det, rr / det};
   }
   return chroma;
 }

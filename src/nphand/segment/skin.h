@@ -132,17 +132,22 @@ class SkinSegmenter {
 
  private:
   void RebuildLookup();
-  // The colours of the faces' skin (SkinOptions::face_chroma): per brightness Y, the
-  // inverse spread over ((Cr - 128) / Y, (Cb - 128) / Y) widened by kFaceChromaFloor / Y.
+  // The colours of the faces' skin (SkinOptions::face_chroma), per brightness Y over the
+  // levels' chroma (Cr - 128, Cb - 128): the mean of ((Cr - 128) / Y, (Cb - 128) / Y) times Y,
+  // and the inverse of its spread (widened by kFaceChromaFloor / Y) over Y², so that a pixel
+  // is judged without a division.
   struct FaceChroma {
-    double cr = 0.0, cb = 0.0;                          // the mean
-    std::array<std::array<double, 3>, 256> inverse{};  // per Y: (rr, rb, bb) of the inverse spread
-    double reach = 0.0;                                 // squared Mahalanobis distance allowed
+    struct Level {
+      double cr = 0.0, cb = 0.0;            // the mean, times Y
+      double rr = 0.0, rb = 0.0, bb = 0.0;  // the inverse spread, over Y²
+    };
+    std::array<Level, 256> levels{};
+    double reach = 0.0;  // squared Mahalanobis distance allowed
     bool Holds(int y, int cr_level, int cb_level) const {
       if (y == 0) return false;
-      const double r = (cr_level - 128.0) / y - cr, b = (cb_level - 128.0) / y - cb;
-      const std::array<double, 3>& m = inverse[y];
-      return m[0] * r * r + 2.0 * m[1] * r * b + m[2] * b * b <= reach;
+      const Level& l = levels[y];
+      const double r = cr_level - 128.0 - l.cr, b = cb_level - 128.0 - l.cb;
+      return l.rr * r * r + 2.0 * l.rb * r * b + l.bb * b * b <= reach;
     }
   };
   // From `ycrcb` (the working frame) and the faces' boxes in its pixels; nullopt when the
