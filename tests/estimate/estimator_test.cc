@@ -323,6 +323,44 @@ TEST_F(EstimatorTest, AHandTheForearmCutWouldMaimIsJudgedWhole) {
   EXPECT_EQ(tried, 3) << "hands the cut maims";
 }
 
+// Two hands side by side, nearer each other than the reach within which an object's pieces
+// are gathered, are two candidates: the estimate is one of them, not both as one.
+TEST_F(EstimatorTest, TwoHandsSideBySideAreNotGatheredAsOne) {
+  EstimatorOptions options = Options();
+  options.skin.adapt = false;
+  Estimator estimator(*db_, *index_, RightHand(), options);
+  int tried = 0;
+  for (size_t e = EntryWithoutObject(*db_, 0); e < db_->size() && tried < 3; e = EntryWithoutObject(*db_, e + 1)) {
+    const cv::Mat labels = estimator.RenderEntry(static_cast<uint32_t>(e)).labels;
+    const cv::Mat hand = labels == static_cast<int>(PixelLabel::kHand);
+    estimator.Reset();
+    if (!estimator.ProcessMask(hand, 0.0).detected()) continue;
+    // The hand at three times the database's size, and beside it a hand a little smaller
+    // (its mirror image: the other hand), a gap of a sixth of the first's width between.
+    cv::Mat near, far;
+    cv::resize(hand, near, {}, 3.0, 3.0, cv::INTER_NEAREST);
+    cv::resize(hand, far, {}, 2.9, 2.9, cv::INTER_NEAREST);
+    cv::flip(far, far, 1);
+    const cv::Rect near_box = cv::boundingRect(near), far_box = cv::boundingRect(far);
+    const int gap = near_box.width / 6;
+    cv::Mat frame(std::max(near_box.height, far_box.height) + 80, near_box.width + far_box.width + gap + 80, CV_8UC3,
+                  cv::Scalar(128, 128, 128));
+    const cv::Rect at_near(40, 40, near_box.width, near_box.height);
+    const cv::Rect at_far(at_near.br().x + gap, 40, far_box.width, far_box.height);
+    frame(at_near).setTo(cv::Scalar(90, 130, 200), near(near_box));
+    frame(at_far).setTo(cv::Scalar(90, 130, 200), far(far_box));
+    ++tried;
+    estimator.Reset();
+    const FrameResult r = estimator.Process(frame, 0.0);
+    ASSERT_TRUE(r.detected()) << "entry " << e << ": " << r.reason;
+    const bool on_near = (r.box & at_near).area() >= 0.9 * at_near.area();
+    const bool on_far = (r.box & at_far).area() >= 0.9 * at_far.area();
+    EXPECT_NE(on_near, on_far) << "entry " << e << ": the estimate is one hand, whole";
+    EXPECT_EQ((r.box & (on_near ? at_far : at_near)).area(), 0) << "entry " << e << ": it reaches into the other hand";
+  }
+  EXPECT_EQ(tried, 3) << "hands the database knows";
+}
+
 // Carried one per mode: the best of a second mode is kept where the first mode's runners-up
 // would have filled every place.
 TEST(CarriedOrderTest, ApartTheBestOfEachModeIsCarried) {
@@ -550,10 +588,12 @@ TEST_F(EstimatorTest, EstimatesKeepOffASkinColouredSweater) {
   const auto [detected, off] = EstimatesOffTheArm(*db_, *index_, options, {12u, 13u}, true, 4);
   options.skin.set_aside_bodies = false;
   const auto [detected_kept, off_kept] = EstimatesOffTheArm(*db_, *index_, options, {12u, 13u}, true, 4);
-  // Measured: 19 estimates, 8 off the hand, against 23 and 18.
+  // Measured: 36 estimates, 8 off the hand, against 44 and 17. Before a region as large as
+  // the candidate was left ungathered (kPieceShare), the body set aside also found the hand
+  // in 4 or more frames more; now the hand is tried alone after the sweater either way.
   EXPECT_GT(off_kept, 12) << "the sweater passes for a hand";
   EXPECT_LT(off, 0.6 * off_kept);
-  EXPECT_GE(detected - off, detected_kept - off_kept + 4) << "more estimates on the hand";
+  EXPECT_GE(detected - off, detected_kept - off_kept) << "no fewer estimates on the hand";
 }
 
 TEST_F(EstimatorTest, RenderedSequenceFramesAreEstimatedWithEveryField) {
