@@ -28,8 +28,12 @@ const SequenceFrame& Frame(bool face = false) {
     Sequence sequence(hand, options);
     return sequence.Render(options.frames / 2);
   };
-  static const SequenceFrame without = render(false), with = render(true);
-  return face ? with : without;
+  if (face) {
+    static const SequenceFrame with = render(true);
+    return with;
+  }
+  static const SequenceFrame without = render(false);
+  return without;
 }
 
 SkinOptions NoFaces() {

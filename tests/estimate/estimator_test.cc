@@ -82,6 +82,9 @@ class EstimatorTest : public ::testing::Test {
   static inline KnnIndex* index_ = nullptr;
 };
 
+// Silhouettes painted as a hand on a grey wall (BGR): skin, and the wall.
+const cv::Scalar kPaintedSkin(90, 130, 200), kGreyWall(128, 128, 128);
+
 // An entry without its object: its pose, its scene.
 size_t EntryWithoutObject(const Database& db, size_t from) {
   for (size_t e = from; e < db.size(); ++e) {
@@ -303,9 +306,9 @@ TEST_F(EstimatorTest, AHandTheForearmCutWouldMaimIsJudgedWhole) {
     cv::resize(labels == static_cast<int>(PixelLabel::kHand), silhouette, {}, 3.0, 3.0, cv::INTER_NEAREST);
     const cv::Rect box = cv::boundingRect(silhouette);
     // The hand on a grey wall, standing on the frame's bottom edge.
-    cv::Mat frame(box.height + 40, box.width + 80, CV_8UC3, cv::Scalar(128, 128, 128));
+    cv::Mat frame(box.height + 40, box.width + 80, CV_8UC3, kGreyWall);
     const cv::Rect at(40, 40, box.width, box.height);
-    frame(at).setTo(cv::Scalar(90, 130, 200), silhouette(box));
+    frame(at).setTo(kPaintedSkin, silhouette(box));
     const ForearmCut cut = CutForearm(silhouette(box), 8);
     if (!cut.cut) continue;
     cv::Mat maimed = cv::Mat::zeros(frame.size(), CV_8UC1);
@@ -344,11 +347,11 @@ TEST_F(EstimatorTest, TwoHandsSideBySideAreNotGatheredAsOne) {
     const cv::Rect near_box = cv::boundingRect(near), far_box = cv::boundingRect(far);
     const int gap = near_box.width / 6;
     cv::Mat frame(std::max(near_box.height, far_box.height) + 80, near_box.width + far_box.width + gap + 80, CV_8UC3,
-                  cv::Scalar(128, 128, 128));
+                  kGreyWall);
     const cv::Rect at_near(40, 40, near_box.width, near_box.height);
     const cv::Rect at_far(at_near.br().x + gap, 40, far_box.width, far_box.height);
-    frame(at_near).setTo(cv::Scalar(90, 130, 200), near(near_box));
-    frame(at_far).setTo(cv::Scalar(90, 130, 200), far(far_box));
+    frame(at_near).setTo(kPaintedSkin, near(near_box));
+    frame(at_far).setTo(kPaintedSkin, far(far_box));
     ++tried;
     estimator.Reset();
     const FrameResult r = estimator.Process(frame, 0.0);
