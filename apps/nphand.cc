@@ -45,6 +45,11 @@ constexpr const char* kFaceChromaHelp =
     "While a face is in view, skin is only the colours within this many standard deviations of its cheeks' "
     "(0: off, as when someone else's face is behind the hand)";
 
+// --arm-agreement of estimate and eval real (EstimatorOptions::arm_agreement).
+constexpr const char* kArmAgreementHelp =
+    "Where a forearm was cut off, how much less a hypothesis weighs whose wrist is turned away from the arm "
+    "(log weight per unit of disagreement; 0: the arm is not looked at)";
+
 // For options held in unsigned fields, which would take "-1" as a huge number.
 CLI::Validator WholeNumber() {
   return CLI::Validator(
@@ -213,6 +218,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
   cmd->add_option("--face-chroma", e.skin.face_chroma, kFaceChromaHelp)->capture_default_str();
   cmd->add_flag("!--no-forearm-cut", e.cut_forearm, "Do not cut the forearm at the wrist");
+  cmd->add_option("--arm-agreement", e.arm_agreement, kArmAgreementHelp)->capture_default_str();
   cmd->add_option("--roi", o.roi, "x,y,width,height: seek the hand in this part of the frame only (skin elsewhere is ignored)")
       ->delimiter(',')
       ->expected(4);
@@ -477,6 +483,7 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
       ->check(WholeNumber())
       ->capture_default_str();
   cmd->add_option("--face-chroma", o.face_chroma, kFaceChromaHelp)->capture_default_str();
+  cmd->add_option("--arm-agreement", o.arm_agreement, kArmAgreementHelp)->capture_default_str();
   cmd->add_flag("--given-box", o.given_box,
                 "The hand's place given: each labelled hand estimated within its box grown by 25 % (its pose judged alone)");
   cmd->add_option("--hand", o.hand, "given (each labelled side searched for) or auto (the estimator chooses, and is scored)")

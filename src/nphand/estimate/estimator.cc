@@ -193,6 +193,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the least share of the hand found last must be within [0, 1)";
   } else if (!(hand_memory >= 0.0 && hand_memory < 1.0) || !(hand_switch >= 0.0 && hand_switch < 10.0)) {
     *why = "the side's memory must be within [0, 1) and its switching margin within [0, 10)";
+  } else if (!(arm_agreement >= 0.0 && arm_agreement <= 100.0)) {
+    *why = "the arm's agreement must be within [0, 100]";
   } else if (learn_interval < 1) {
     *why = "the learning interval must be at least 1 frame";
   } else if (!skin.Check(why) || !forearm.Check(why) || !refinement.Check(why) || !smoothing.Check(why)) {
@@ -511,22 +513,26 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
     cv::Mat hand = cv::Mat::zeros(bgr.size(), CV_8UC1);
     cv::Rect box = region_box;
     bool cut = false;
+    std::optional<cv::Point2d> arm;
     if (options_.cut_forearm) {
       const ForearmCut forearm = CutForearm(region, Border(region_box, view), options_.forearm);
       cut = forearm.cut;
       forearm.hand.copyTo(hand(region_box));
-      if (cut) box = cv::boundingRect(forearm.hand) + region_box.tl();
+      if (cut) {
+        box = cv::boundingRect(forearm.hand) + region_box.tl();
+        arm = forearm.arm_direction;
+      }
     } else {
       region.copyTo(hand(region_box));
     }
     result.ms.segment += Ms(part, Clock::now());
-    FrameResult attempt = EstimateHand(hand, box, result);
+    FrameResult attempt = EstimateHand(hand, box, arm, result);
     attempt.forearm_cut = cut;
     if (cut && !attempt.detected() && attempt.searched) {
       // The cut may have gone through the hand: the whole region is judged as well (the cut
       // hand lies within the region's box, which the region overwrites).
       region.copyTo(hand(region_box));
-      FrameResult whole = EstimateHand(hand, region_box, result);
+      FrameResult whole = EstimateHand(hand, region_box, std::nullopt, result);
       AddLookupTime(attempt, &whole);
       attempt = std::move(whole);
     }
@@ -563,32 +569,36 @@ FrameResult Estimator::DetectMask(const cv::Mat& mask, double time_s) {
     carried_.clear();
     return result;
   }
-  FrameResult out = EstimateHand(mask != 0, box, result);
+  FrameResult out = EstimateHand(mask != 0, box, std::nullopt, result);
   if (!out.detected()) carried_.clear();
   out.ms.total = Ms(start, Clock::now());
   return out;
 }
 
-FrameResult Estimator::EstimateSide(const cv::Mat& hand_mask, cv::Rect box, Handedness side, FrameResult result) {
+FrameResult Estimator::EstimateSide(const cv::Mat& hand_mask, cv::Rect box, Handedness side, const std::optional<cv::Point2d>& arm,
+                                    FrameResult result) {
   result.hand = side;
-  if (side == Handedness::kRight) return Estimate(hand_mask, box, hand_mask.size(), std::move(result));
+  if (side == Handedness::kRight) return Estimate(hand_mask, box, hand_mask.size(), arm, std::move(result));
   cv::Mat mirrored;
   cv::flip(hand_mask, mirrored, 1);
   const cv::Rect mirrored_box(hand_mask.cols - box.x - box.width, box.y, box.width, box.height);
-  FrameResult out = Estimate(mirrored, mirrored_box, hand_mask.size(), std::move(result));
+  const std::optional<cv::Point2d> mirrored_arm =
+      arm.has_value() ? std::optional<cv::Point2d>(cv::Point2d(-arm->x, arm->y)) : std::nullopt;
+  FrameResult out = Estimate(mirrored, mirrored_box, hand_mask.size(), mirrored_arm, std::move(result));
   if (out.detected()) MirrorResult(hand_mask.cols, &out);
   out.box = box;
   return out;
 }
 
-FrameResult Estimator::EstimateHand(const cv::Mat& hand_mask, cv::Rect box, FrameResult result) {
-  if (!options_.hand_auto) return EstimateSide(hand_mask, box, options_.hand, std::move(result));
+FrameResult Estimator::EstimateHand(const cv::Mat& hand_mask, cv::Rect box, const std::optional<cv::Point2d>& arm,
+                                    FrameResult result) {
+  if (!options_.hand_auto) return EstimateSide(hand_mask, box, options_.hand, arm, std::move(result));
   const Handedness other = side_ == Handedness::kRight ? Handedness::kLeft : Handedness::kRight;
-  FrameResult held = EstimateSide(hand_mask, box, side_, result);
+  FrameResult held = EstimateSide(hand_mask, box, side_, arm, result);
   // The other side starts without the carried hypotheses: they are poses of this side's.
   std::vector<WeightedPose> held_carried = std::move(carried_);
   carried_.clear();
-  FrameResult turned = EstimateSide(hand_mask, box, other, std::move(result));
+  FrameResult turned = EstimateSide(hand_mask, box, other, arm, std::move(result));
   // Both searched (a region too thin for a hand is searched for neither): the difference
   // of their nearest distances is this frame's evidence.
   // Once a frame: a region judged again whole is the same frame's evidence.
@@ -629,6 +639,7 @@ struct Candidate {
 
 // A frame's region as it passes Estimate's stages.
 struct Estimator::Lookup {
+  std::optional<cv::Point2d> arm;     // the forearm's direction, if one was cut off
   cv::Rect roi;                       // the hand's box, padded, within the frame
   std::vector<HandCrop> crops;        // the crop, and its half turn when its ends look alike
   std::vector<Descriptor> descriptors;
@@ -753,6 +764,15 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     for (size_t i = 0; i < hyp.size(); ++i) {
       const double d = hyp[i].distance - nearest;
       log_w[i] = -d * d / (2.0 * var);
+    }
+  }
+  if (lookup->arm.has_value() && options_.arm_agreement > 0.0) {
+    // The hand frame's x runs from the wrist to the middle finger's knuckle: the palm-to-wrist
+    // direction in the camera is the rotation's first column, negated (x right, y down).
+    const cv::Point2d arm = *lookup->arm;
+    for (size_t i = 0; i < hyp.size(); ++i) {
+      const double px = -hyp[i].x[0], py = -hyp[i].x[3];
+      log_w[i] += options_.arm_agreement * (arm.x * px + arm.y * py - std::hypot(px, py));
     }
   }
   const double top_log = *std::max_element(log_w.begin(), log_w.end());
@@ -951,8 +971,10 @@ void Estimator::Place(const Lookup& lookup, int crop, const EntryPlacement& entr
   result->ms.place = Ms(t, Clock::now());
 }
 
-FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, FrameResult result) {
+FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, const std::optional<cv::Point2d>& arm,
+                                FrameResult result) {
   Lookup lookup;
+  lookup.arm = arm;
   if (!Describe(hand_mask, box, frame, &lookup, &result)) return result;
   Search(&lookup, &result);
   if (!Weigh(box, &lookup, &result)) return result;

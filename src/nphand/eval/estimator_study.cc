@@ -74,6 +74,12 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     name << "arm-length" << length;
     around_default(name.str(), [&](EstimatorOptions& e) { e.forearm.min_arm_length = length; });
   }
+  // How much a hand turned against the arm it was cut from weighs less.
+  for (double agreement : {0.0, 2.0, 8.0, 16.0}) {
+    std::ostringstream name;
+    name << "arm" << agreement;
+    around_default(name.str(), [&](EstimatorOptions& e) { e.arm_agreement = agreement; });
+  }
   // How far the nearest view may lie before a region is "no hand".
   for (double distance : {0.85, 0.9}) {
     std::ostringstream name;
