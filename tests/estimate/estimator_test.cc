@@ -426,6 +426,43 @@ TEST_F(EstimatorTest, TwoHandsSideBySideAreNotGatheredAsOne) {
   EXPECT_EQ(tried, 3) << "hands the database knows";
 }
 
+// Specks of skin colour beside a hand, within the reach where an object's pieces are
+// gathered, spread the region's box until it looks like no hand: the hand alone is judged
+// then, before the whole region uncut.
+TEST_F(EstimatorTest, StraySpecksBesideAHandAreLeftOut) {
+  EstimatorOptions options = Options();
+  options.skin.adapt = false;
+  options.max_distance = 0.3;
+  Estimator estimator(*db_, *index_, RightHand(), options);
+  int tried = 0;
+  for (size_t e = EntryWithoutObject(*db_, 0); e < db_->size() && tried < 3; e = EntryWithoutObject(*db_, e + 1)) {
+    const cv::Mat labels = estimator.RenderEntry(static_cast<uint32_t>(e)).labels;
+    cv::Mat hand;
+    cv::resize(labels == static_cast<int>(PixelLabel::kHand), hand, {}, 3.0, 3.0, cv::INTER_NEAREST);
+    const cv::Rect box = cv::boundingRect(hand);
+    const int side = std::max(box.width, box.height), reach = side / 5, radius = std::max(4, side / 25);
+    cv::Mat silhouette = cv::Mat::zeros(box.height + 2 * reach + 80, box.width + 2 * reach + 80, CV_8UC1);
+    const cv::Rect at(40 + reach, 40 + reach, box.width, box.height);
+    hand(box).copyTo(silhouette(at));
+    // Two specks off opposite corners of the hand's box, a fifth of its longer side out.
+    cv::Mat specks = cv::Mat::zeros(silhouette.size(), CV_8UC1);
+    cv::circle(specks, at.tl() - cv::Point(reach, reach) + cv::Point(radius, radius), radius, 255, cv::FILLED);
+    cv::circle(specks, at.br() + cv::Point(reach, reach) - cv::Point(radius, radius), radius, 255, cv::FILLED);
+    estimator.Reset();
+    if (!estimator.ProcessMask(silhouette, 0.0).detected() || estimator.ProcessMask(silhouette | specks, 0.0).detected()) continue;
+    ASSERT_LT(cv::countNonZero(specks), 0.05 * cv::countNonZero(silhouette)) << "specks, not pieces of a hand";
+    cv::Mat frame(silhouette.size(), CV_8UC3, kGreyWall);
+    frame.setTo(kPaintedSkin, silhouette | specks);
+    ++tried;
+    estimator.Reset();
+    const FrameResult r = estimator.Process(frame, 0.0);
+    ASSERT_TRUE(r.detected()) << "entry " << e << ": " << r.reason;
+    EXPECT_GE((r.box & at).area(), 0.9 * at.area()) << "entry " << e;
+    EXPECT_EQ(cv::countNonZero(specks(r.box)), 0) << "entry " << e << ": the box reaches a speck";
+  }
+  EXPECT_EQ(tried, 3) << "hands the specks hide";
+}
+
 // Carried one per mode: the best of a second mode is kept where the first mode's runners-up
 // would have filled every place.
 TEST(CarriedOrderTest, ApartTheBestOfEachModeIsCarried) {

@@ -32,19 +32,30 @@ double Ms(Clock::time_point from, Clock::time_point to) {
 // object parts from the hand for hands (16.4 -> 17.6 mm).
 constexpr double kPieceShare = 0.9;
 
+// Pieces gathered with a region that together hold under this share of its pixels may be
+// stray skin-coloured things beside the hand, which spread the region's box until it looks
+// like no hand: then the region alone is judged too. Chosen by the validation sweep
+// (docs/estimator.md): 0.05 16.14 -> 15.74 mm against every share (1.0), 0.2 15.82.
+constexpr double kStrayShare = 0.05;
+
 // A hand region together with the pieces an object splits off it (skin regions, under
 // kPieceShare of its pixels, whose boxes meet the region's box grown by 30 % of its longer
-// side): their pixels within `*box`, which gets the pixels' bounds.
+// side): their pixels within `*box`, which gets the pixels' bounds. `pieces`: whether
+// to gather them (false: the region alone); `gathered` (if not null) gets the pieces' pixels.
 // Only pixels within `view` count (the frame, or the caller's region of interest).
-cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, const cv::Rect& view, cv::Rect* box) {
+cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, const cv::Rect& view, bool pieces, cv::Rect* box,
+                   int* gathered) {
   const cv::Rect reach = HandReach(seed.box & view);
+  int pixels = 0;
   std::vector<int> labels = {seed.label};
   cv::Rect bounds = seed.box & view;
   for (const SkinRegion& r : s.regions) {
-    if (r.label == seed.label || (r.box & view & reach).area() == 0 || r.area >= kPieceShare * seed.area) continue;
+    if (!pieces || r.label == seed.label || (r.box & view & reach).area() == 0 || r.area >= kPieceShare * seed.area) continue;
     labels.push_back(r.label);
     bounds |= r.box & view;
+    pixels += r.area;
   }
+  if (gathered != nullptr) *gathered = pixels;
   const cv::Mat mask = s.Mask(labels, bounds);
   const cv::Rect tight = cv::boundingRect(mask);
   *box = tight + bounds.tl();
@@ -505,36 +516,48 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
     result.ms.total = Ms(start, Clock::now());
     return result;
   }
-  // The best region that looks like a hand; a second try if the first does not.
-  for (size_t c = 0; c < std::min<size_t>(2, candidates.size()); ++c) {
+  // A region, gathered with its pieces or alone, cut at the wrist (with `cut`) and judged.
+  // `hand` gets the mask judged, `gathered` (if not null) the pieces' pixels.
+  auto judge = [&](const SkinRegion& candidate, bool pieces, bool cut, cv::Mat* hand, int* gathered) {
     const Clock::time_point part = Clock::now();
-    cv::Rect region_box;
-    const cv::Mat region = GatherHand(skin, *candidates[c], view, &region_box);
-    cv::Mat hand = cv::Mat::zeros(bgr.size(), CV_8UC1);
-    cv::Rect box = region_box;
-    bool cut = false;
+    cv::Rect box;
+    const cv::Mat region = GatherHand(skin, candidate, view, pieces, &box, gathered);
+    *hand = cv::Mat::zeros(bgr.size(), CV_8UC1);
     std::optional<cv::Point2d> arm;
-    if (options_.cut_forearm) {
-      const ForearmCut forearm = CutForearm(region, Border(region_box, view), options_.forearm);
-      cut = forearm.cut;
-      forearm.hand.copyTo(hand(region_box));
-      if (cut) {
-        box = cv::boundingRect(forearm.hand) + region_box.tl();
+    bool cut_off = false;
+    if (cut) {
+      const ForearmCut forearm = CutForearm(region, Border(box, view), options_.forearm);
+      forearm.hand.copyTo((*hand)(box));
+      if ((cut_off = forearm.cut)) {
+        box = cv::boundingRect(forearm.hand) + box.tl();
         arm = forearm.arm_direction;
       }
     } else {
-      region.copyTo(hand(region_box));
+      region.copyTo((*hand)(box));
     }
     result.ms.segment += Ms(part, Clock::now());
-    FrameResult attempt = EstimateHand(hand, box, arm, result);
-    attempt.forearm_cut = cut;
-    if (cut && !attempt.detected() && attempt.searched) {
-      // The cut may have gone through the hand: the whole region is judged as well (the cut
-      // hand lies within the region's box, which the region overwrites).
-      region.copyTo(hand(region_box));
-      FrameResult whole = EstimateHand(hand, region_box, std::nullopt, result);
-      AddLookupTime(attempt, &whole);
-      attempt = std::move(whole);
+    FrameResult attempt = EstimateHand(*hand, box, arm, result);
+    attempt.forearm_cut = cut_off;
+    return attempt;
+  };
+  // The best region that looks like a hand; a second try if the first does not.
+  for (size_t c = 0; c < std::min<size_t>(2, candidates.size()); ++c) {
+    cv::Mat hand;
+    int gathered = 0;
+    FrameResult attempt = judge(*candidates[c], true, options_.cut_forearm, &hand, &gathered);
+    const bool cut = attempt.forearm_cut, searched = attempt.searched;
+    // Then, while none is a hand: the region without the pieces gathered (skin-coloured
+    // things beside the hand), and the whole region uncut (the cut may have gone through
+    // the hand).
+    if (!attempt.detected() && searched && gathered > 0 && gathered < kStrayShare * candidates[c]->area) {
+      FrameResult next = judge(*candidates[c], false, options_.cut_forearm, &hand, nullptr);
+      AddLookupTime(attempt, &next);
+      attempt = std::move(next);
+    }
+    if (!attempt.detected() && searched && cut) {
+      FrameResult next = judge(*candidates[c], true, false, &hand, nullptr);
+      AddLookupTime(attempt, &next);
+      attempt = std::move(next);
     }
     if (attempt.detected() || c + 1 == std::min<size_t>(2, candidates.size())) {
       // The hand is lost: the next frame starts from its observation alone.
