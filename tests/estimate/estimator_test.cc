@@ -68,15 +68,22 @@ class EstimatorTest : public ::testing::Test {
     options.smooth = false;
     return options;
   }
-  // The scene of entry `e` seen by `camera` at `distance`, turned in the image by `roll`.
-  static Scene EntryScene(size_t e, double roll, double distance) {
-    const EntryMeta meta = db_->Meta(e);
+  // Entry `e`'s hand seen from `direction` at `distance`, turned in the image by `roll`.
+  static Scene ViewScene(size_t e, const Eigen::Vector3d& direction, double roll, double distance) {
     Scene scene;
     scene.hand.angles = db_->Angles(e);
-    const std::vector<Eigen::Vector3d> directions = ViewSphereDirections(64);
-    scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(directions[meta.viewpoint], roll));
+    scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(direction, roll));
     scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, RightHand().bind_centre(), distance);
     return scene;
+  }
+  // The database's 64 view directions.
+  static const std::vector<Eigen::Vector3d>& Directions() {
+    static const std::vector<Eigen::Vector3d> directions = ViewSphereDirections(64);
+    return directions;
+  }
+  // The scene of entry `e` seen by its own camera at `distance`, turned in the image by `roll`.
+  static Scene EntryScene(size_t e, double roll, double distance) {
+    return ViewScene(e, Directions()[db_->Meta(e).viewpoint], roll, distance);
   }
   static inline Database* db_ = nullptr;
   static inline KnnIndex* index_ = nullptr;
@@ -84,6 +91,16 @@ class EstimatorTest : public ::testing::Test {
 
 // Silhouettes painted as a hand on a grey wall (BGR): skin, and the wall.
 const cv::Scalar kPaintedSkin(90, 130, 200), kGreyWall(128, 128, 128);
+
+// Entry `e`'s hand pixels as the database rendered them, enlarged `scale` times (nearest
+// pixels).
+cv::Mat EntryHand(Estimator& estimator, size_t e, double scale = 1.0) {
+  const cv::Mat hand = estimator.RenderEntry(static_cast<uint32_t>(e)).labels == static_cast<int>(PixelLabel::kHand);
+  if (scale == 1.0) return hand;
+  cv::Mat enlarged;
+  cv::resize(hand, enlarged, {}, scale, scale, cv::INTER_NEAREST);
+  return enlarged;
+}
 
 // An entry without its object: its pose, its scene.
 size_t EntryWithoutObject(const Database& db, size_t from) {
@@ -196,7 +213,7 @@ TEST_F(EstimatorTest, PlacementsKeptOrMadeAfreshAreTheSame) {
   for (size_t from = 0; masks.size() < 40; from += 13) {
     const size_t e = EntryWithoutObject(*db_, from);
     if (!entries.insert(e).second) continue;
-    masks.push_back(estimator.RenderEntry(static_cast<uint32_t>(e)).labels == static_cast<int>(PixelLabel::kHand));
+    masks.push_back(EntryHand(estimator, e));
   }
   std::set<uint32_t> placed;
   std::vector<FrameResult> first;
@@ -300,10 +317,8 @@ TEST_F(EstimatorTest, AHandTheForearmCutWouldMaimIsJudgedWhole) {
   Estimator estimator(*db_, *index_, RightHand(), options);
   int tried = 0;
   for (size_t e = EntryWithoutObject(*db_, 0); e < db_->size() && tried < 3; e = EntryWithoutObject(*db_, e + 1)) {
-    const cv::Mat labels = estimator.RenderEntry(static_cast<uint32_t>(e)).labels;
     // Three times the database's size, so that the skin mask's clean-up keeps the fingers.
-    cv::Mat silhouette;
-    cv::resize(labels == static_cast<int>(PixelLabel::kHand), silhouette, {}, 3.0, 3.0, cv::INTER_NEAREST);
+    const cv::Mat silhouette = EntryHand(estimator, e, 3.0);
     const cv::Rect box = cv::boundingRect(silhouette);
     // The hand on a grey wall, standing on the frame's bottom edge.
     cv::Mat frame(box.height + 40, box.width + 80, CV_8UC3, kGreyWall);
@@ -326,8 +341,6 @@ TEST_F(EstimatorTest, AHandTheForearmCutWouldMaimIsJudgedWhole) {
   EXPECT_EQ(tried, 3) << "hands the cut maims";
 }
 
-// Two hands side by side, nearer each other than the reach within which an object's pieces
-// are gathered, are two candidates: the estimate is one of them, not both as one.
 // Where a forearm was cut off, a hand turned against its arm weighs less. Views of the
 // database's hands from between its directions, rolled, painted as skin on a grey wall with
 // an arm: their own forearm, or a bar as wide as a wrist from the middle fingertip onwards to
@@ -344,16 +357,12 @@ TEST_F(EstimatorTest, AHandTurnedAgainstItsArmWeighsLess) {
     options.arm_agreement = agreement;
     Estimator estimator(*db_, *index_, RightHand(), options);
     Random random(testing::kTestSeed);
-    const std::vector<Eigen::Vector3d> directions = ViewSphereDirections(64);
     int cut = 0, against = 0;
     for (size_t e = EntryWithoutObject(*db_, 0), n = 0; e < db_->size() && n < 100; e = EntryWithoutObject(*db_, e + 11), ++n) {
       // Seen from between the database's directions (about 25 degrees apart), rolled.
       const Eigen::Vector3d direction =
-          (directions[db_->Meta(e).viewpoint] + 0.2 * Eigen::Vector3d(random.Normal(), random.Normal(), random.Normal())).normalized();
-      Scene scene;
-      scene.hand.angles = db_->Angles(e);
-      scene.hand.camera_from_hand = CameraFromHand(ViewpointFromDirection(direction, random.Uniform(-180.0, 180.0) * kDeg));
-      scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, RightHand().bind_centre(), 0.45);
+          (Directions()[db_->Meta(e).viewpoint] + 0.2 * Eigen::Vector3d(random.Normal(), random.Normal(), random.Normal())).normalized();
+      Scene scene = ViewScene(e, direction, random.Uniform(-180.0, 180.0) * kDeg, 0.45);
       if (!bar) scene.forearm = Forearm{};
       cv::Mat labels;
       renderer.RenderLabels(scene, camera, &labels);
@@ -390,14 +399,15 @@ TEST_F(EstimatorTest, AHandTurnedAgainstItsArmWeighsLess) {
   EXPECT_LE(turned(by_default, true).second, bar_cut / 10) << "by default the arm decides between near views, no more";
 }
 
+// Two hands side by side, nearer each other than the reach within which an object's pieces
+// are gathered, are two candidates: the estimate is one of them, not both as one.
 TEST_F(EstimatorTest, TwoHandsSideBySideAreNotGatheredAsOne) {
   EstimatorOptions options = Options();
   options.skin.adapt = false;
   Estimator estimator(*db_, *index_, RightHand(), options);
   int tried = 0;
   for (size_t e = EntryWithoutObject(*db_, 0); e < db_->size() && tried < 3; e = EntryWithoutObject(*db_, e + 1)) {
-    const cv::Mat labels = estimator.RenderEntry(static_cast<uint32_t>(e)).labels;
-    const cv::Mat hand = labels == static_cast<int>(PixelLabel::kHand);
+    const cv::Mat hand = EntryHand(estimator, e);
     estimator.Reset();
     if (!estimator.ProcessMask(hand, 0.0).detected()) continue;
     // The hand at three times the database's size, and beside it a hand a little smaller
@@ -436,9 +446,7 @@ TEST_F(EstimatorTest, StraySpecksBesideAHandAreLeftOut) {
   Estimator estimator(*db_, *index_, RightHand(), options);
   int tried = 0;
   for (size_t e = EntryWithoutObject(*db_, 0); e < db_->size() && tried < 3; e = EntryWithoutObject(*db_, e + 1)) {
-    const cv::Mat labels = estimator.RenderEntry(static_cast<uint32_t>(e)).labels;
-    cv::Mat hand;
-    cv::resize(labels == static_cast<int>(PixelLabel::kHand), hand, {}, 3.0, 3.0, cv::INTER_NEAREST);
+    const cv::Mat hand = EntryHand(estimator, e, 3.0);
     const cv::Rect box = cv::boundingRect(hand);
     const int side = std::max(box.width, box.height), reach = side / 5, radius = std::max(4, side / 25);
     cv::Mat silhouette = cv::Mat::zeros(box.height + 2 * reach + 80, box.width + 2 * reach + 80, CV_8UC1);
@@ -962,7 +970,7 @@ TEST_F(EstimatorTest, TheTracksViewsJoinTheNeighboursInATrack) {
   const auto track = [&](int views) {
     options.track_views = views;
     Estimator estimator(*db_, *index_, RightHand(), options);
-    const cv::Mat mask = estimator.RenderEntry(static_cast<uint32_t>(e)).labels == static_cast<int>(PixelLabel::kHand);
+    const cv::Mat mask = EntryHand(estimator, e);
     return std::vector<FrameResult>{estimator.ProcessMask(mask, 0.0), estimator.ProcessMask(mask, 1.0 / 30)};
   };
   const std::vector<FrameResult> alone = track(0), tracked = track(4);

@@ -516,24 +516,35 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
     result.ms.total = Ms(start, Clock::now());
     return result;
   }
-  // A region, gathered with its pieces or alone, cut at the wrist (with `cut`) and judged.
-  // `hand` gets the mask judged, `gathered` (if not null) the pieces' pixels.
-  auto judge = [&](const SkinRegion& candidate, bool pieces, bool cut, cv::Mat* hand, int* gathered) {
-    const Clock::time_point part = Clock::now();
+  // A candidate gathered with its pieces, or alone (`pieces`): its pixels within its box;
+  // `gathered` (if not null) gets the pieces' pixels.
+  struct Region {
+    cv::Mat mask;
     cv::Rect box;
-    const cv::Mat region = GatherHand(skin, candidate, view, pieces, &box, gathered);
+  };
+  auto gather = [&](const SkinRegion& candidate, bool pieces, int* gathered) {
+    const Clock::time_point part = Clock::now();
+    Region region;
+    region.mask = GatherHand(skin, candidate, view, pieces, &region.box, gathered);
+    result.ms.segment += Ms(part, Clock::now());
+    return region;
+  };
+  // A region cut at the wrist (with `cut`) and judged; `hand` gets the mask judged.
+  auto judge = [&](const Region& region, bool cut, cv::Mat* hand) {
+    const Clock::time_point part = Clock::now();
+    cv::Rect box = region.box;
     *hand = cv::Mat::zeros(bgr.size(), CV_8UC1);
     std::optional<cv::Point2d> arm;
     bool cut_off = false;
     if (cut) {
-      const ForearmCut forearm = CutForearm(region, Border(box, view), options_.forearm);
+      const ForearmCut forearm = CutForearm(region.mask, Border(box, view), options_.forearm);
       forearm.hand.copyTo((*hand)(box));
       if ((cut_off = forearm.cut)) {
         box = cv::boundingRect(forearm.hand) + box.tl();
         arm = forearm.arm_direction;
       }
     } else {
-      region.copyTo((*hand)(box));
+      region.mask.copyTo((*hand)(box));
     }
     result.ms.segment += Ms(part, Clock::now());
     FrameResult attempt = EstimateHand(*hand, box, arm, result);
@@ -543,22 +554,21 @@ FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::opti
   // The best region that looks like a hand; a second try if the first does not.
   for (size_t c = 0; c < std::min<size_t>(2, candidates.size()); ++c) {
     cv::Mat hand;
-    int gathered = 0;
-    FrameResult attempt = judge(*candidates[c], true, options_.cut_forearm, &hand, &gathered);
+    int pieces = 0;
+    const Region gathered = gather(*candidates[c], true, &pieces);
+    FrameResult attempt = judge(gathered, options_.cut_forearm, &hand);
     const bool cut = attempt.forearm_cut, searched = attempt.searched;
-    // Then, while none is a hand: the region without the pieces gathered (skin-coloured
-    // things beside the hand), and the whole region uncut (the cut may have gone through
-    // the hand).
-    if (!attempt.detected() && searched && gathered > 0 && gathered < kStrayShare * candidates[c]->area) {
-      FrameResult next = judge(*candidates[c], false, options_.cut_forearm, &hand, nullptr);
+    auto retry = [&](const Region& region, bool cut_again) {
+      FrameResult next = judge(region, cut_again, &hand);
       AddLookupTime(attempt, &next);
       attempt = std::move(next);
-    }
-    if (!attempt.detected() && searched && cut) {
-      FrameResult next = judge(*candidates[c], true, false, &hand, nullptr);
-      AddLookupTime(attempt, &next);
-      attempt = std::move(next);
-    }
+    };
+    // Then, while none is a hand: the region without the pieces gathered where they are
+    // specks (skin-coloured things beside the hand), and the whole region uncut (the cut may
+    // have gone through the hand).
+    const bool specks = pieces > 0 && pieces < kStrayShare * candidates[c]->area;
+    if (!attempt.detected() && searched && specks) retry(gather(*candidates[c], false, nullptr), options_.cut_forearm);
+    if (!attempt.detected() && searched && cut) retry(gathered, false);
     if (attempt.detected() || c + 1 == std::min<size_t>(2, candidates.size())) {
       // The hand is lost: the next frame starts from its observation alone.
       if (!attempt.detected()) carried_.clear();
@@ -605,8 +615,8 @@ FrameResult Estimator::EstimateSide(const cv::Mat& hand_mask, cv::Rect box, Hand
   cv::Mat mirrored;
   cv::flip(hand_mask, mirrored, 1);
   const cv::Rect mirrored_box(hand_mask.cols - box.x - box.width, box.y, box.width, box.height);
-  const std::optional<cv::Point2d> mirrored_arm =
-      arm.has_value() ? std::optional<cv::Point2d>(cv::Point2d(-arm->x, arm->y)) : std::nullopt;
+  std::optional<cv::Point2d> mirrored_arm = arm;
+  if (mirrored_arm.has_value()) mirrored_arm->x = -mirrored_arm->x;
   FrameResult out = Estimate(mirrored, mirrored_box, hand_mask.size(), mirrored_arm, std::move(result));
   if (out.detected()) MirrorResult(hand_mask.cols, &out);
   out.box = box;
@@ -795,7 +805,7 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     const cv::Point2d arm = *lookup->arm;
     for (size_t i = 0; i < hyp.size(); ++i) {
       const double px = -hyp[i].x[0], py = -hyp[i].x[3];
-      log_w[i] += options_.arm_agreement * (arm.x * px + arm.y * py - std::hypot(px, py));
+      log_w[i] += options_.arm_agreement * (arm.x * px + arm.y * py - std::sqrt(px * px + py * py));
     }
   }
   const double top_log = *std::max_element(log_w.begin(), log_w.end());
