@@ -145,14 +145,20 @@ void AddRim(int largest, cv::Mat* rim, cv::Mat* skin) {
   *skin |= *rim == kKept;
 }
 
+// In front of a face, skin taken whole where it goes on outside as an arm (a value of
+// InFrontOfFaces), for a neck going on into a skin-coloured sweater goes on outside too:
+// such skin does not keep a body below the face from being set aside as one.
+constexpr uint8_t kInFrontWhole = 128;
+
 // Of the skin within the faces' heads (`heads`: 255 within them; all images at the working
 // resolution, `bounds` holding the heads), what lies in front of a face: 255 where the skin
 // is parted from the skin at a face's centre (the middle half of its box, `centres`) by the
 // frame's edges, in pieces of at least `least` pixels or that reach skin outside the
-// faces' shapes (`shapes`: heads and necks). A hand over a face shows its outline against
-// it; the face's own edges (eyes, mouth, hair line) part smaller pieces of it, a cheek or
-// the brow, which stay the face's. An arm or a hand passing the side of a face, within its
-// head's ellipse only in a sliver, goes on outside it.
+// faces' shapes (`shapes`: heads and necks), and kInFrontWhole where it is taken whole
+// (below). A hand over a face shows its outline against it; the face's own edges (eyes,
+// mouth, hair line) part smaller pieces of it, a cheek or the brow, which stay the face's.
+// An arm or a hand passing the side of a face, within its head's ellipse only in a sliver,
+// goes on outside it.
 cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& heads, const cv::Mat& shapes,
                        cv::Rect bounds, const std::vector<cv::Rect>& centres, double least) {
   cv::Mat in_front = cv::Mat::zeros(work.size(), CV_8UC1);
@@ -175,17 +181,26 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   // stay apart.
   const int count = cv::connectedComponentsWithStats(pieces, labels, stats, centroids, 4, CV_32S);
   if (count <= 1) return in_front;
+  // Pixels by label of `of` (`n` labels) within each centre.
+  auto in_centres = [&](const cv::Mat& of, int n) {
+    std::vector<std::vector<int>> pixels;
+    for (const cv::Rect& centre : centres) {
+      const cv::Rect at = (centre - bounds.tl()) & cv::Rect(0, 0, bounds.width, bounds.height);
+      pixels.emplace_back(n, 0);
+      for (int y = at.y; y < at.y + at.height; ++y) {
+        const int* label = of.ptr<int>(y);
+        for (int x = at.x; x < at.x + at.width; ++x) ++pixels.back()[label[x]];
+      }
+    }
+    return pixels;
+  };
   // Each face is the piece with most pixels in its centre.
   std::vector<uint8_t> face(count, 0);
-  for (const cv::Rect& centre : centres) {
-    const cv::Rect at = (centre - bounds.tl()) & cv::Rect(0, 0, bounds.width, bounds.height);
-    std::vector<int> pixels(count, 0);
-    for (int y = at.y; y < at.y + at.height; ++y) {
-      const int* label = labels.ptr<int>(y);
-      for (int x = at.x; x < at.x + at.width; ++x) ++pixels[label[x]];
-    }
+  std::vector<int> face_centre;  // by centre: its face's pixels there
+  for (const std::vector<int>& pixels : in_centres(labels, count)) {
     const auto most = std::max_element(pixels.begin() + 1, pixels.end());
     if (*most > 0) face[most - pixels.begin()] = 1;
+    face_centre.push_back(*most);
   }
   // The pieces that reach skin outside the shapes, over what the edges and the opening
   // took from their ends.
@@ -221,6 +236,38 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
     for (int x = 0; x < labels.cols; ++x) keep[x] |= joined[label[x]] != 0 ? 255 : 0;
   }
   in_front(bounds) = kept & head_skin & ~face_pieces;
+  // A hand's own creases and shading can shred it into pieces the opening takes, so that
+  // little of it is kept. The skin beyond the face's pieces, taken whole, that goes on
+  // outside the shapes (an arm) and of which less than kWholeShare was kept, is kept whole
+  // (kInFrontWhole), unless it holds more of a face's centre than the face's piece does (a
+  // face's own features shred it too, and its piece is then a part of it).
+  cv::Mat rest_labels;
+  const int rests = cv::connectedComponents(head_skin & ~face_zone, rest_labels, 4, CV_32S);
+  std::vector<uint8_t> arm = LabelsMeeting(rest_labels, rests, outside);
+  arm[0] = 0;
+  const std::vector<std::vector<int>> rest_centre = in_centres(rest_labels, rests);
+  for (size_t c = 0; c < rest_centre.size(); ++c) {
+    for (int r = 1; r < rests; ++r) arm[r] &= rest_centre[c][r] <= face_centre[c] ? 1 : 0;
+  }
+  std::vector<int> area(rests, 0), covered(rests, 0);
+  cv::Mat front = in_front(bounds);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* rest = rest_labels.ptr<int>(y);
+    const uint8_t* in = front.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      ++area[rest[x]];
+      covered[rest[x]] += in[x] != 0;
+    }
+  }
+  constexpr double kWholeShare = 0.75;
+  for (int r = 1; r < rests; ++r) arm[r] &= covered[r] < kWholeShare * area[r] ? 1 : 0;
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* rest = rest_labels.ptr<int>(y);
+    uint8_t* in = front.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      if (in[x] == 0 && arm[rest[x]] != 0) in[x] = kInFrontWhole;
+    }
+  }
   return in_front;
 }
 
@@ -482,7 +529,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
         centres.emplace_back(f.x + f.width / 4, f.y + f.height / 4, f.width / 2, f.height / 2);
       }
       in_front = InFrontOfFaces(work, out.skin, heads, face_mask, bounds, centres, least_hand);
-      face_mask &= ~in_front;
+      face_mask.setTo(0, in_front);
     }
     out.face_pixels = cv::countNonZero(out.skin & face_mask) * scale * scale;
     out.skin.setTo(0, face_mask);
@@ -495,9 +542,11 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   // a leftover is a sliver.
   std::vector<int> near_face;  // by label: its pixels in the zone (empty without faces)
   std::vector<uint8_t> before_face;  // by label: it holds skin in front of a face
+  std::vector<uint8_t> parted_front;  // by label: it holds skin an outline parts from a face
   if (!faces_.empty()) {
     near_face.assign(stats.size(), 0);
     before_face.assign(stats.size(), 0);
+    parted_front.assign(stats.size(), 0);
     cv::Mat zone = cv::Mat::zeros(work.size(), CV_8UC1);
     const cv::Rect bounds = draw_faces(0.2, true, &zone);
     for (int y = bounds.y; y < bounds.y + bounds.height; ++y) {
@@ -506,7 +555,9 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       const int* label = out.labels.ptr<int>(y);
       for (int x = bounds.x; x < bounds.x + bounds.width; ++x) {
         near_face[label[x]] += in_zone[x] != 0;
-        if (front != nullptr && front[x] != 0) before_face[label[x]] = 1;
+        if (front == nullptr || front[x] == 0) continue;
+        before_face[label[x]] = 1;
+        if (front[x] != kInFrontWhole) parted_front[label[x]] = 1;
       }
     }
   }
@@ -537,7 +588,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       for (int x = from; x < to; ++x) ++met[bottom[x]];
       auto piece = [&](int label) {
         return label != 0 && met[label] >= kBodyPiece * f.width && stats[label].box.height <= kBodyHeight * met[label] &&
-               (before_face.empty() || before_face[label] == 0);
+               (parted_front.empty() || parted_front[label] == 0);
       };
       int left = to, right = from;
       for (int x = from; x < to; ++x) {
