@@ -149,6 +149,8 @@ void AddRim(int largest, cv::Mat* rim, cv::Mat* skin) {
 // InFrontOfFaces), for a neck going on into a skin-coloured sweater goes on outside too:
 // such skin does not keep a body below the face from being set aside as one.
 constexpr uint8_t kInFrontWhole = 128;
+// Skin in front of a face is taken whole where the pieces' rule kept less than this share of it.
+constexpr double kWholeShare = 0.75;
 
 // Of the skin within the faces' heads (`heads`: 255 within them; all images at the working
 // resolution, `bounds` holding the heads), what lies in front of a face: 255 where the skin
@@ -241,26 +243,23 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   // outside the shapes (an arm) and of which less than kWholeShare was kept, is kept whole
   // (kInFrontWhole), unless it holds more of a face's centre than the face's piece does (a
   // face's own features shred it too, and its piece is then a part of it).
-  cv::Mat rest_labels;
-  const int rests = cv::connectedComponents(head_skin & ~face_zone, rest_labels, 4, CV_32S);
+  cv::Mat rest_labels, rest_stats, rest_centroids;
+  const int rests =
+      cv::connectedComponentsWithStats(head_skin & ~face_zone, rest_labels, rest_stats, rest_centroids, 4, CV_32S);
   std::vector<uint8_t> arm = LabelsMeeting(rest_labels, rests, outside);
   arm[0] = 0;
   const std::vector<std::vector<int>> rest_centre = in_centres(rest_labels, rests);
   for (size_t c = 0; c < rest_centre.size(); ++c) {
     for (int r = 1; r < rests; ++r) arm[r] &= rest_centre[c][r] <= face_centre[c] ? 1 : 0;
   }
-  std::vector<int> area(rests, 0), covered(rests, 0);
+  std::vector<int> covered(rests, 0);
   cv::Mat front = in_front(bounds);
   for (int y = 0; y < labels.rows; ++y) {
     const int* rest = rest_labels.ptr<int>(y);
     const uint8_t* in = front.ptr<uint8_t>(y);
-    for (int x = 0; x < labels.cols; ++x) {
-      ++area[rest[x]];
-      covered[rest[x]] += in[x] != 0;
-    }
+    for (int x = 0; x < labels.cols; ++x) covered[rest[x]] += in[x] != 0;
   }
-  constexpr double kWholeShare = 0.75;
-  for (int r = 1; r < rests; ++r) arm[r] &= covered[r] < kWholeShare * area[r] ? 1 : 0;
+  for (int r = 1; r < rests; ++r) arm[r] &= covered[r] < kWholeShare * rest_stats.at<int>(r, cv::CC_STAT_AREA) ? 1 : 0;
   for (int y = 0; y < labels.rows; ++y) {
     const int* rest = rest_labels.ptr<int>(y);
     uint8_t* in = front.ptr<uint8_t>(y);
