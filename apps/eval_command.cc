@@ -126,6 +126,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   EstimatorOptions estimator_options;
   if (!options.faces) estimator_options.skin.face_cascade.clear();
   estimator_options.refine = options.refine;
+  SetRefineMoves(options.refine_move, &estimator_options.refinement);
   estimator_options.max_distance = options.max_distance;
   estimator_options.k = options.k;
   estimator_options.track_views = options.track_views;
@@ -150,6 +151,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["index"] = index.Backend();
   result.figures["hand"] = options.hand;
   result.figures["refine"] = options.refine;
+  result.figures["refine_move"] = options.refine_move;
   result.figures["max_distance"] = options.max_distance;
   result.figures["k"] = options.k;
   result.figures["track_views"] = options.track_views;

@@ -11,6 +11,7 @@
 #include "nphand/eval/pose_report.h"
 #include "nphand/eval/pose_study.h"
 #include "nphand/eval/feature_study.h"
+#include "nphand/refine/refiner.h"
 
 namespace nphand {
 
@@ -82,6 +83,7 @@ struct EvalRealCommandOptions : EstimatorFiles {
   bool faces = true;              // set faces aside (OpenCV's cascade)
   std::string hand = "given";     // "given": the labelled side; "auto": the estimator chooses
   bool refine = false;            // the estimator refines its best view (refine/refiner.h)
+  std::vector<std::string> refine_move = RefineMoves(RefineOptions{});  // what the refinement moves (SetRefineMoves)
   double max_distance = EstimatorOptions{}.max_distance;  // "no hand" beyond this feature distance
   int k = EstimatorOptions{}.k;            // neighbours searched
   int track_views = EstimatorOptions{}.track_views;  // viewpoints of the track's views searched besides

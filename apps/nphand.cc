@@ -50,6 +50,9 @@ constexpr const char* kArmAgreementHelp =
     "Where a forearm was cut off, how much less a hypothesis weighs whose wrist is turned away from the arm "
     "(log weight per unit of disagreement; 0: the arm is not looked at)";
 
+// --refine-move of estimate and eval real (SetRefineMoves).
+constexpr const char* kRefineMoveHelp = "Refinement: what moves, any of place, wrist, fingers and proportions";
+
 // For options held in unsigned fields, which would take "-1" as a huge number.
 CLI::Validator WholeNumber() {
   return CLI::Validator(
@@ -225,7 +228,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_flag("--refine,!--no-refine", e.refine, "Refine the best view's pose until its silhouette agrees with the hand's");
   cmd->add_option("--refine-sweeps", e.refinement.sweeps, "Refinement: passes over the wrist's and fingers' directions")
       ->capture_default_str();
-  cmd->add_option("--refine-move", o.refine_move, "Refinement: what moves, any of place, wrist, fingers and proportions")
+  cmd->add_option("--refine-move", o.refine_move, kRefineMoveHelp)
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_flag("--smooth,!--no-smooth", e.smooth, "Smooth the track's poses over time (a One Euro filter)")->capture_default_str();
@@ -472,6 +475,9 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_option("--out", o.out_dir, "Folder for real.json, real_predictions.jsonl and real_contact.png");
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
   cmd->add_flag("--refine", o.refine, "Refine each estimate's best view against the hand's silhouette");
+  cmd->add_option("--refine-move", o.refine_move, kRefineMoveHelp)
+      ->delimiter(',')
+      ->capture_default_str();
   cmd->add_option("--max-distance", o.max_distance, "No hand when the nearest view is farther than this")->capture_default_str();
   cmd->add_option("--k", o.k, "Neighbours searched per frame")->capture_default_str();
   cmd->add_option("--track-views", o.track_views,

@@ -342,6 +342,12 @@ TEST_F(EstimateCommandTest, EvalRealEstimatesEveryLabelledImageAndWritesItsFiles
   refined.refine = true;
   refined.out_dir.clear();
   EXPECT_EQ(RunEvalReal(refined, nullptr).figures["refine"], true);
+  // --refine-move: what the refinement moves, reported; an unknown move refused.
+  EvalRealCommandOptions fingers = refined;
+  fingers.refine_move = {"place", "wrist", "fingers"};
+  EXPECT_EQ(RunEvalReal(fingers, nullptr).figures["refine_move"], nlohmann::json({"place", "wrist", "fingers"}));
+  fingers.refine_move = {"palm"};
+  testing::ExpectError([&] { RunEvalReal(fingers, nullptr); }, "unknown refinement move 'palm'");
   // --given-box: each labelled hand estimated within its found region.
   EvalRealCommandOptions boxed = options;
   boxed.given_box = true;
