@@ -2,6 +2,8 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "apps/estimator_files.h"
 #include "nphand/eval/ann_study.h"
