@@ -8,6 +8,8 @@
 #include <signal.h>
 #include <cstdio>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <opencv2/core/utils/logger.hpp>
@@ -50,9 +52,6 @@ constexpr const char* kArmAgreementHelp =
     "Where a forearm was cut off, how much less a hypothesis weighs whose wrist is turned away from the arm "
     "(log weight per unit of disagreement; 0: the arm is not looked at)";
 
-// --refine-move of estimate and eval real (SetRefineMoves).
-constexpr const char* kRefineMoveHelp = "Refinement: what moves, any of place, wrist, fingers and proportions";
-
 // For options held in unsigned fields, which would take "-1" as a huge number.
 CLI::Validator WholeNumber() {
   return CLI::Validator(
@@ -67,6 +66,13 @@ void AddGraspCheck(CLI::Option* option) {
   option->check(CLI::Validator(
       [](std::string& item) { return item.empty() ? std::string("an empty item (expected e.g. 1,13)") : std::string(); },
       "", "non-empty"));
+}
+
+// --refine-move of estimate and eval real: names, comma-separated (SetRefineMoves).
+void AddRefineMoveOption(CLI::App* cmd, std::vector<std::string>& moves) {
+  cmd->add_option("--refine-move", moves, "Refinement: what moves, any of place, wrist, fingers and proportions")
+      ->delimiter(',')
+      ->capture_default_str();
 }
 
 // The files a command that estimates reads: one option group for every such command.
@@ -228,9 +234,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_flag("--refine,!--no-refine", e.refine, "Refine the best view's pose until its silhouette agrees with the hand's");
   cmd->add_option("--refine-sweeps", e.refinement.sweeps, "Refinement: passes over the wrist's and fingers' directions")
       ->capture_default_str();
-  cmd->add_option("--refine-move", o.refine_move, kRefineMoveHelp)
-      ->delimiter(',')
-      ->capture_default_str();
+  AddRefineMoveOption(cmd, o.refine_move);
   cmd->add_flag("--smooth,!--no-smooth", e.smooth, "Smooth the track's poses over time (a One Euro filter)")->capture_default_str();
   cmd->add_option("--smooth-cutoff", e.smoothing.min_cutoff_hz, "Smoothing: the cutoff of a still hand, Hz")->capture_default_str();
   cmd->add_option("--smooth-beta", e.smoothing.beta, "Smoothing: the cutoff's rise with the hand's speed")->capture_default_str();
@@ -475,9 +479,7 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_option("--out", o.out_dir, "Folder for real.json, real_predictions.jsonl and real_contact.png");
   cmd->add_flag("!--no-faces", o.faces, "Do not look for faces");
   cmd->add_flag("--refine", o.refine, "Refine each estimate's best view against the hand's silhouette");
-  cmd->add_option("--refine-move", o.refine_move, kRefineMoveHelp)
-      ->delimiter(',')
-      ->capture_default_str();
+  AddRefineMoveOption(cmd, o.refine_move);
   cmd->add_option("--max-distance", o.max_distance, "No hand when the nearest view is farther than this")->capture_default_str();
   cmd->add_option("--k", o.k, "Neighbours searched per frame")->capture_default_str();
   cmd->add_option("--track-views", o.track_views,
