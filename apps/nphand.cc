@@ -141,6 +141,8 @@ void AddSequenceCommand(CLI::App& app, nphand::SequenceCommandOptions& o) {
   cmd->add_option("--beyond-steps", s.beyond_steps, "How far the hand opens (and, empty, closes) past the database's steps")
       ->capture_default_str();
   cmd->add_option("--forearm", o.forearm, "none, bare or sleeved")->capture_default_str();
+  cmd->add_flag("--adult-arm", s.adult_arm,
+                "An adult's forearm (rounder and thicker towards the elbow) and upper arm, not the cone sized to the mesh's wrist");
   cmd->add_option("--skin", s.skin, "Skin tone: light, medium, olive, brown, dark (default: by the seed)");
   cmd->add_option("--background", o.background, "plain, texture or clutter")->capture_default_str();
   cmd->add_flag("--face", s.face, "Put a face beside the hand");

@@ -187,6 +187,54 @@ TEST(RendererTest, ForearmAddsItsOwnPixelsBehindTheWristAndIsClosed) {
   EXPECT_EQ(cv::norm(with_arm.labels, labels_only, cv::NORM_INF), 0.0);
 }
 
+// An adult's forearm seen across the palm widens from the wrist to the elbow by its width's
+// scale, seen edge-on by its thickness's (it is rounder at the elbow than the wrist); its
+// upper arm goes on beyond the elbow as thick as the elbow.
+TEST(RendererTest, AnAdultsArmWidensToARounderElbowAndGoesOn) {
+  Renderer renderer(RightHand());
+  const Forearm adult = Forearm::Adult();
+  Forearm forearm_only = adult;
+  forearm_only.upper_arm_length = 0.0;
+  struct View {
+    Viewpoint from;
+    double widening;
+  };
+  for (const View& view : {View{{0.0, 0.0, 0.0}, adult.elbow_width_scale},
+                           View{{0.0, std::numbers::pi / 2.0, 0.0}, adult.elbow_depth_scale}}) {
+    Scene scene = HandScene(view.from, NamedArticulation("relaxed"));
+    scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, RightHand().bind_centre(), 2.0);
+    auto arm_of = [&](const Forearm& forearm, cv::Rect* hand) {
+      scene.forearm = forearm;
+      cv::Mat labels;
+      renderer.RenderLabels(scene, kCamera, &labels);
+      *hand = cv::boundingRect(labels == static_cast<int>(PixelLabel::kHand));
+      return cv::Mat(labels == static_cast<int>(PixelLabel::kForearm));
+    };
+    cv::Rect hand;
+    const cv::Mat arm = arm_of(forearm_only, &hand);
+    const cv::Rect elbow = cv::boundingRect(arm);
+    ASSERT_GT(elbow.y + elbow.height, hand.y + hand.height + 25) << view.from.elevation;
+    // The widths of the rows just below the hand and just short of the elbow's cap.
+    const double wrist = cv::countNonZero(arm.row(hand.y + hand.height + 2));
+    const double at_elbow = cv::countNonZero(arm.row(elbow.y + elbow.height - 3));
+    // The wrist's row lies a little towards the elbow from the wrist end (inside the hand).
+    EXPECT_GT(at_elbow / wrist, 0.8 * view.widening) << view.from.elevation;
+    EXPECT_LT(at_elbow / wrist, 1.1 * view.widening) << view.from.elevation;
+    // The upper arm, seen from further off to be whole: the arm below the hand (all but the
+    // centimetre of the wrist end inside it) longer by the upper arm's length, as thick as the
+    // elbow's end at its own.
+    scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, RightHand().bind_centre(), 4.0);
+    const double forearm_rows = cv::boundingRect(arm_of(forearm_only, &hand)).br().y - hand.br().y;
+    const cv::Mat whole = arm_of(adult, &hand);
+    const cv::Rect upper = cv::boundingRect(whole);
+    ASSERT_LT(upper.br().y, kCamera.height) << view.from.elevation;
+    EXPECT_NEAR((upper.br().y - hand.br().y) / forearm_rows, (adult.length + adult.upper_arm_length - 0.01) / (adult.length - 0.01),
+                0.15)
+        << view.from.elevation;
+    EXPECT_NEAR(cv::countNonZero(whole.row(upper.br().y - 2)), at_elbow / 2.0, 2.0) << view.from.elevation;
+  }
+}
+
 TEST(RendererTest, BadInputsAreRefused) {
   Renderer renderer(RightHand());
   Scene scene = HandScene({}, {});
@@ -200,7 +248,11 @@ TEST(RendererTest, BadInputsAreRefused) {
   options = {};
   options.skin_colour = cv::Vec3f(300, 0, 0);
   EXPECT_THROW(renderer.Render(scene, kCamera, options), Error);
-  scene.forearm = Forearm{-0.1, 1.0};
+  scene.forearm = Forearm{-0.1, 1.0, 1.0};
+  EXPECT_THROW(renderer.RenderLabels(scene, kCamera, &labels), Error);
+  scene.forearm = Forearm{0.24, 1.6, 0.0};
+  EXPECT_THROW(renderer.RenderLabels(scene, kCamera, &labels), Error);
+  scene.forearm = Forearm{0.24, 1.6, 2.1, -0.3};
   EXPECT_THROW(renderer.RenderLabels(scene, kCamera, &labels), Error);
   scene.forearm.reset();
   scene.hand.handedness = Handedness::kLeft;

@@ -192,6 +192,25 @@ TEST(SequenceTest, ASweaterIsSkinThatIsNotAHandAndChangesNothingElse) {
   testing::ExpectError([&] { Sequence(RightHand(), dressed); }, "a sweater needs a face");
 }
 
+// An adult's arm changes only the arm: the same hand and truth, more arm pixels.
+TEST(SequenceTest, AnAdultsArmIsMoreArmAndChangesNothingElse) {
+  SequenceOptions mesh_sized = Small(testing::kTestSeed + 6);
+  SequenceOptions adult = mesh_sized;
+  adult.adult_arm = true;
+  Sequence a(RightHand(), mesh_sized), b(RightHand(), adult);
+  for (int i : {0, 11}) {
+    const SequenceFrame fa = a.Render(i), fb = b.Render(i);
+    EXPECT_EQ(FrameTruthJson(fa), FrameTruthJson(fb)) << i;
+    const int arm_a = cv::countNonZero(fa.labels == static_cast<int>(PixelLabel::kForearm));
+    const int arm_b = cv::countNonZero(fb.labels == static_cast<int>(PixelLabel::kForearm));
+    EXPECT_GT(arm_b, arm_a) << i;
+  }
+  EXPECT_FALSE(a.Describe()["adult_arm"].get<bool>());
+  EXPECT_TRUE(b.Describe()["adult_arm"].get<bool>());
+  adult.forearm = ForearmKind::kNone;
+  testing::ExpectError([&] { Sequence(RightHand(), adult); }, "an adult's arm needs a forearm");
+}
+
 TEST(SequenceTest, BadOptionsAreRefused) {
   SequenceOptions options = Small(1);
   options.frames = 0;

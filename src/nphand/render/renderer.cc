@@ -25,34 +25,45 @@ bool IsColour(const cv::Vec3f& c) {
          c[0] <= 255 && c[1] <= 255 && c[2] <= 255;
 }
 
-// An elliptic truncated cone along -x: rings at x0 (wrist end, inside the mesh) and x1
-// (elbow end), centred on (y, z) = centre, with caps; wound outward.
-TriangleMesh MakeForearmMesh(const Eigen::Vector2f& centre, const Eigen::Vector2f& wrist_radii, double x0, double x1,
-                             double elbow_scale) {
+// The arm along -x: an elliptic truncated cone from the ring at x0 (the wrist end, inside the
+// mesh) to the ring at x1 (the elbow end, its radii `elbow_scale` times the wrist end's), and
+// with `upper` > 0 a cylinder on from the elbow's ring to a ring at x1 - upper (the upper
+// arm); centred on (y, z) = centre, with caps; wound outward. The sequences' cameras never
+// look from the arm's side (sequence.cc), so no ring lies behind the camera.
+TriangleMesh MakeArmMesh(const Eigen::Vector2f& centre, const Eigen::Vector2f& wrist_radii, double x0, double x1,
+                         const Eigen::Vector2f& elbow_scale, double upper) {
   TriangleMesh mesh;
   const int n = kForearmSegments;
-  for (int end = 0; end < 2; ++end) {
-    const float x = static_cast<float>(end == 0 ? x0 : x1);
-    const float scale = end == 0 ? 1.0f : static_cast<float>(elbow_scale);
+  const int rings = upper > 0.0 ? 3 : 2;
+  // A ring's normals, from its radii as factors of the wrist's.
+  const float aspect = elbow_scale.x() / elbow_scale.y();
+  for (int ring = 0; ring < rings; ++ring) {
+    const float x = static_cast<float>(ring == 0 ? x0 : ring == 1 ? x1 : x1 - upper);
+    const Eigen::Vector2f scale = ring == 0 ? Eigen::Vector2f::Ones() : elbow_scale;
+    const float ring_aspect = ring == 0 ? 1.0f : aspect;
     for (int i = 0; i < n; ++i) {
       const float a = static_cast<float>(2.0 * std::numbers::pi * i / n);
       const float cy = std::cos(a), sz = std::sin(a);
-      mesh.vertices.emplace_back(x, centre.x() + scale * wrist_radii.x() * cy, centre.y() + scale * wrist_radii.y() * sz);
-      mesh.normals.push_back(Eigen::Vector3f(0.0f, cy / wrist_radii.x(), sz / wrist_radii.y()).normalized());
+      mesh.vertices.emplace_back(x, centre.x() + scale.x() * wrist_radii.x() * cy,
+                                 centre.y() + scale.y() * wrist_radii.y() * sz);
+      mesh.normals.push_back(Eigen::Vector3f(0.0f, cy / wrist_radii.x(), ring_aspect * sz / wrist_radii.y()).normalized());
     }
   }
-  for (int end = 0; end < 2; ++end) {
-    mesh.vertices.emplace_back(static_cast<float>(end == 0 ? x0 : x1), centre.x(), centre.y());
-    mesh.normals.emplace_back(end == 0 ? 1.0f : -1.0f, 0.0f, 0.0f);
-  }
-  const int cap0 = 2 * n, cap1 = 2 * n + 1;
+  mesh.vertices.emplace_back(static_cast<float>(x0), centre.x(), centre.y());
+  mesh.normals.emplace_back(1.0f, 0.0f, 0.0f);
+  mesh.vertices.emplace_back(static_cast<float>(rings == 3 ? x1 - upper : x1), centre.x(), centre.y());
+  mesh.normals.emplace_back(-1.0f, 0.0f, 0.0f);
+  const int cap0 = rings * n, cap1 = rings * n + 1, last = (rings - 1) * n;
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
-    // Side: the ring at x0 lies on +x of the ring at x1.
-    mesh.triangles.emplace_back(i, n + i, n + j);
-    mesh.triangles.emplace_back(i, n + j, j);
+    // Sides: each ring lies on +x of the next.
+    for (int ring = 0; ring + 1 < rings; ++ring) {
+      const int near = ring * n, far = near + n;
+      mesh.triangles.emplace_back(near + i, far + i, far + j);
+      mesh.triangles.emplace_back(near + i, far + j, near + j);
+    }
     mesh.triangles.emplace_back(cap0, i, j);
-    mesh.triangles.emplace_back(cap1, n + j, n + i);
+    mesh.triangles.emplace_back(cap1, last + j, last + i);
   }
   return mesh;
 }
@@ -97,7 +108,9 @@ const TriangleMesh& Renderer::ObjectMesh(const ObjectSpec& spec) {
 
 const TriangleMesh& Renderer::ForearmMesh(const Forearm& forearm) {
   if (forearm_cache_.has_value() && forearm_cache_->first.length == forearm.length &&
-      forearm_cache_->first.elbow_scale == forearm.elbow_scale) {
+      forearm_cache_->first.elbow_width_scale == forearm.elbow_width_scale &&
+      forearm_cache_->first.elbow_depth_scale == forearm.elbow_depth_scale &&
+      forearm_cache_->first.upper_arm_length == forearm.upper_arm_length) {
     return forearm_cache_->second;
   }
   // The wrist's cross-section: the bind-pose vertices within 1 cm of the mesh's proximal end.
@@ -110,8 +123,9 @@ const TriangleMesh& Renderer::ForearmMesh(const Forearm& forearm) {
     low = low.cwiseMin(v.tail<2>());
     high = high.cwiseMax(v.tail<2>());
   }
-  forearm_cache_.emplace(forearm, MakeForearmMesh(0.5f * (low + high), 0.5f * (high - low), min_x + 0.01,
-                                                  min_x - forearm.length, forearm.elbow_scale));
+  const Eigen::Vector2f elbow_scale(static_cast<float>(forearm.elbow_width_scale), static_cast<float>(forearm.elbow_depth_scale));
+  forearm_cache_.emplace(forearm, MakeArmMesh(0.5f * (low + high), 0.5f * (high - low), min_x + 0.01, min_x - forearm.length,
+                                              elbow_scale, forearm.upper_arm_length));
   return forearm_cache_->second;
 }
 

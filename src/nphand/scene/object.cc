@@ -204,8 +204,10 @@ double SignedDistance(const ObjectSpec& spec, const Eigen::Vector3d& p) {
 namespace nphand {
 
 bool Forearm::Check(std::string* why) const {
-  if (!(length > 0.0 && length <= 1.0) || !(elbow_scale >= 0.5 && elbow_scale <= 3.0)) {
-    *why = "a forearm's length must be within (0, 1] metres and its elbow scale within [0.5, 3]";
+  if (!(length > 0.0 && length <= 1.0) || !(elbow_width_scale >= 0.5 && elbow_width_scale <= 3.0) ||
+      !(elbow_depth_scale >= 0.5 && elbow_depth_scale <= 3.0) || !(upper_arm_length >= 0.0 && upper_arm_length <= 1.0)) {
+    *why = "a forearm's length must be within (0, 1] metres, its elbow scales within [0.5, 3] and its upper arm's "
+           "length within [0, 1] metres";
     return false;
   }
   return true;

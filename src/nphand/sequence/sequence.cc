@@ -88,6 +88,8 @@ bool SequenceOptions::Check(std::string* why) const {
     *why = "unknown skin tone '" + skin + "' (choose light, medium, olive, brown or dark)";
   } else if (sweater && !face) {
     *why = "a sweater needs a face (it is the person's)";
+  } else if (adult_arm && forearm == ForearmKind::kNone) {
+    *why = "an adult's arm needs a forearm (bare or sleeved)";
   } else {
     return true;
   }
@@ -229,7 +231,7 @@ SequenceFrame Sequence::Render(int i) {
                           Eigen::Vector3d(reach * std::sin(1.3 * std::numbers::pi * t + phases_[2]),
                                           0.6 * reach * std::sin(std::numbers::pi * t + phases_[3]), 0.0);
   if (options_.object) scene.objects = {grasp_.object};
-  if (options_.forearm != ForearmKind::kNone) scene.forearm = Forearm{};
+  if (options_.forearm != ForearmKind::kNone) scene.forearm = options_.adult_arm ? Forearm::Adult() : Forearm{};
 
   RenderOptions render;
   render.skin_colour = skin_bgr_;
@@ -280,6 +282,7 @@ nlohmann::json Sequence::Describe() const {
           {"object_scale", object_scale},
           {"beyond_steps", options_.beyond_steps},
           {"forearm", ToString(options_.forearm)},
+          {"adult_arm", options_.adult_arm},
           {"skin", skin_},
           {"background", ToString(options_.background)},
           {"face", options_.face},

@@ -53,6 +53,9 @@ struct SequenceOptions {
   // at the start and, without an object, closes past its final step by as many at the end.
   double beyond_steps = 0.5;
   ForearmKind forearm = ForearmKind::kBare;
+  // The forearm an adult's (Forearm::Adult: rounder and thicker towards the elbow, and the
+  // upper arm beyond it) instead of the cone sized to the mesh's wrist; needs a forearm.
+  bool adult_arm = false;
   std::string skin;               // a SkinTones() name; empty: chosen by the seed
   BackgroundKind background = BackgroundKind::kTexture;
   bool face = false;              // a face beside the hand: skin that is not a hand
