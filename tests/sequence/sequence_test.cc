@@ -192,8 +192,8 @@ TEST(SequenceTest, ASweaterIsSkinThatIsNotAHandAndChangesNothingElse) {
   testing::ExpectError([&] { Sequence(RightHand(), dressed); }, "a sweater needs a face");
 }
 
-// An adult's arm changes only the arm: the same hand and truth, more arm pixels.
-TEST(SequenceTest, AnAdultsArmIsMoreArmAndChangesNothingElse) {
+// An adult's arm changes the arm, not the hand's truth: the same truth, more arm pixels.
+TEST(SequenceTest, AnAdultsArmIsMoreArmAndKeepsTheTruth) {
   SequenceOptions mesh_sized = Small(testing::kTestSeed + 6);
   SequenceOptions adult = mesh_sized;
   adult.adult_arm = true;
