@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -32,32 +33,35 @@ bool IsColour(const cv::Vec3f& c) {
 // look from the arm's side (sequence.cc), so no ring lies behind the camera.
 TriangleMesh MakeArmMesh(const Eigen::Vector2f& centre, const Eigen::Vector2f& wrist_radii, double x0, double x1,
                          const Eigen::Vector2f& elbow_scale, double upper) {
+  struct Ring {
+    double x;
+    Eigen::Vector2f scale;  // its radii over the wrist end's
+  };
+  std::vector<Ring> rings = {{x0, Eigen::Vector2f::Ones()}, {x1, elbow_scale}};
+  if (upper > 0.0) rings.push_back({x1 - upper, elbow_scale});
   TriangleMesh mesh;
   const int n = kForearmSegments;
-  const int rings = upper > 0.0 ? 3 : 2;
-  // A ring's normals, from its radii as factors of the wrist's.
-  const float aspect = elbow_scale.x() / elbow_scale.y();
-  for (int ring = 0; ring < rings; ++ring) {
-    const float x = static_cast<float>(ring == 0 ? x0 : ring == 1 ? x1 : x1 - upper);
-    const Eigen::Vector2f scale = ring == 0 ? Eigen::Vector2f::Ones() : elbow_scale;
-    const float ring_aspect = ring == 0 ? 1.0f : aspect;
+  for (const Ring& ring : rings) {
+    // Across an elliptic ring of radii (sx rx, sy ry) the normal runs along (cy / rx, (sx / sy) sz / ry).
+    const float aspect = ring.scale.x() / ring.scale.y();
     for (int i = 0; i < n; ++i) {
       const float a = static_cast<float>(2.0 * std::numbers::pi * i / n);
       const float cy = std::cos(a), sz = std::sin(a);
-      mesh.vertices.emplace_back(x, centre.x() + scale.x() * wrist_radii.x() * cy,
-                                 centre.y() + scale.y() * wrist_radii.y() * sz);
-      mesh.normals.push_back(Eigen::Vector3f(0.0f, cy / wrist_radii.x(), ring_aspect * sz / wrist_radii.y()).normalized());
+      mesh.vertices.emplace_back(static_cast<float>(ring.x), centre.x() + ring.scale.x() * wrist_radii.x() * cy,
+                                 centre.y() + ring.scale.y() * wrist_radii.y() * sz);
+      mesh.normals.push_back(Eigen::Vector3f(0.0f, cy / wrist_radii.x(), aspect * sz / wrist_radii.y()).normalized());
     }
   }
-  mesh.vertices.emplace_back(static_cast<float>(x0), centre.x(), centre.y());
+  mesh.vertices.emplace_back(static_cast<float>(rings.front().x), centre.x(), centre.y());
   mesh.normals.emplace_back(1.0f, 0.0f, 0.0f);
-  mesh.vertices.emplace_back(static_cast<float>(rings == 3 ? x1 - upper : x1), centre.x(), centre.y());
+  mesh.vertices.emplace_back(static_cast<float>(rings.back().x), centre.x(), centre.y());
   mesh.normals.emplace_back(-1.0f, 0.0f, 0.0f);
-  const int cap0 = rings * n, cap1 = rings * n + 1, last = (rings - 1) * n;
+  const int count = static_cast<int>(rings.size());
+  const int cap0 = count * n, cap1 = count * n + 1, last = (count - 1) * n;
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
     // Sides: each ring lies on +x of the next.
-    for (int ring = 0; ring + 1 < rings; ++ring) {
+    for (int ring = 0; ring + 1 < count; ++ring) {
       const int near = ring * n, far = near + n;
       mesh.triangles.emplace_back(near + i, far + i, far + j);
       mesh.triangles.emplace_back(near + i, far + j, near + j);
@@ -107,12 +111,7 @@ const TriangleMesh& Renderer::ObjectMesh(const ObjectSpec& spec) {
 }
 
 const TriangleMesh& Renderer::ForearmMesh(const Forearm& forearm) {
-  if (forearm_cache_.has_value() && forearm_cache_->first.length == forearm.length &&
-      forearm_cache_->first.elbow_width_scale == forearm.elbow_width_scale &&
-      forearm_cache_->first.elbow_depth_scale == forearm.elbow_depth_scale &&
-      forearm_cache_->first.upper_arm_length == forearm.upper_arm_length) {
-    return forearm_cache_->second;
-  }
+  if (forearm_cache_.has_value() && forearm_cache_->first == forearm) return forearm_cache_->second;
   // The wrist's cross-section: the bind-pose vertices within 1 cm of the mesh's proximal end.
   float min_x = std::numeric_limits<float>::max();
   for (const Eigen::Vector3f& v : hand_.bind_vertices()) min_x = std::min(min_x, v.x());

@@ -22,6 +22,7 @@ struct Forearm {
   double elbow_depth_scale = 1.35;    // the same across the hand's thickness (palm to back)
   double upper_arm_length = 0.0;      // metres beyond the elbow (0: the arm ends there)
   bool Check(std::string* why) const;
+  bool operator==(const Forearm&) const = default;
 
   // An adult's arm. The mesh's wrist is 5.3 x 3.3 cm across (the hand's width by its
   // thickness, 13.6 cm round); a forearm near the elbow is rounder and 24-29 cm round
