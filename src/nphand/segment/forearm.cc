@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <deque>
+#include <limits>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -111,10 +113,11 @@ EdgeContact ContactOf(const std::vector<MaskRun>& runs, const Frame& f, double t
 }  // namespace
 
 bool ForearmCutOptions::Check(std::string* why) const {
-  if (!(widen_ratio > 1.0 && widen_ratio < 5.0) || !(min_arm_width > 0.0 && min_arm_width < 1.0) ||
+  if (!(widen_ratio > 1.0 && widen_ratio < 5.0) || !(widen_within > 0.0 && widen_within <= 100.0) ||
+      !(min_arm_width > 0.0 && min_arm_width < 1.0) ||
       !(min_arm_length >= 0.0 && min_arm_length < 10.0) || !(min_arm_length_at_edge >= 0.0 && min_arm_length_at_edge < 10.0) ||
       !(wrist_reach > 0.0 && wrist_reach <= 10.0)) {
-    *why = "forearm cut needs widen ratio in (1, 5), arm width in (0, 1), arm lengths in [0, 10) and wrist reach in (0, 10]";
+    *why = "forearm cut needs widen ratio in (1, 5), widening stretch in (0, 100], arm width in (0, 1), arm lengths in [0, 10) and wrist reach in (0, 10]";
     return false;
   }
   return true;
@@ -188,7 +191,7 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
   // From one end (direction +1: from t_min), the narrow stretch's end before the widening
   // (steps from that end), or -1. `past_contact`: at the frame's edge, begin past the
   // stretch the edge cuts (EdgeContact).
-  auto find_wrist = [&](int direction, bool past_contact, double* wrist_width) {
+  auto find_wrist = [&](int direction, bool past_contact, double within, double* wrist_width) {
     auto index = [&](int step) { return direction > 0 ? step : slices - 1 - step; };
     // Skip the end's cap, where the width still grows: a rounded end, or an arm that leaves
     // the frame obliquely, whose cut edge can rise unevenly, so there the cap lasts until
@@ -206,15 +209,26 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
         if (width[index(first)] >= 0.9 * next[next.size() / 2]) break;
       }
     }
-    // The hand starts where the width first exceeds widen_ratio times the narrowest seen.
+    // The hand starts where the width first exceeds widen_ratio times the narrowest of the
+    // last `within` narrowest widths' slices (infinite: all so far): their minimum kept by a
+    // monotonic queue (steps of increasing width), the stretch's start only moving on as the
+    // narrowest shrinks.
     double narrowest = 1e300;
     int hand_start = -1;
+    std::deque<int> behind;
     for (int step = first; step < slices; ++step) {
       const double w = width[index(step)];
-      if (step > first && w > options.widen_ratio * narrowest) {
-        hand_start = step;
-        break;
+      if (step > first) {
+        const double back = within * narrowest;
+        const int stretch_start = back >= step - first ? first : step - std::max(1, static_cast<int>(std::lround(back)));
+        while (behind.front() < stretch_start) behind.pop_front();
+        if (w > options.widen_ratio * width[index(behind.front())]) {
+          hand_start = step;
+          break;
+        }
       }
+      while (!behind.empty() && width[index(behind.back())] >= w) behind.pop_back();
+      behind.push_back(step);
       narrowest = std::min(narrowest, w);
     }
     if (hand_start < 0) return -1;
@@ -249,11 +263,17 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
   // that leaves the frame at a slant widens along that stretch as a hand does, but the
   // stretch may also hold the wrist of a hand that meets the edge, or be a body's side (a
   // third of the region or more: no arm's end).
-  auto from_end = [&](int direction, double* w) {
-    const int at = find_wrist(direction, false, w);
+  auto from_end_within = [&](int direction, double within, double* w) {
+    const int at = find_wrist(direction, false, within, w);
     const double cap = direction > 0 ? contact.cap_low : contact.cap_high;
     if (at >= 0 || cap < 1.0 || cap >= slices / 3.0) return at;
-    return find_wrist(direction, true, w);
+    return find_wrist(direction, true, within, w);
+  };
+  // The widening is judged against the narrowest so far first, and where that finds no arm
+  // before it (an adult's arm widening towards its elbow), against the last stretch's.
+  auto from_end = [&](int direction, double* w) {
+    const int at = from_end_within(direction, std::numeric_limits<double>::infinity(), w);
+    return at >= 0 ? at : from_end_within(direction, options.widen_within, w);
   };
   const int from_low = from_end(+1, &width_low);
   const int from_high = from_end(-1, &width_high);

@@ -6,6 +6,10 @@
 // narrowest point of the whole arm may be its far end). An arm that leaves the frame at a
 // slant is cut by the frame's edge over a stretch whose slices widen from nothing: where
 // reading from its end finds no wrist, the profile is read again from beyond that stretch.
+// An adult's arm read from its capped far end widens towards the elbow by more than the
+// hand's widening ratio, but gradually: where the widening against the narrowest width so
+// far leaves no arm before it, the profile is read again with the widening judged within
+// one width, as a hand widens.
 // A region without a forearm has no narrow stretch before a widening and is left whole.
 #pragma once
 
@@ -19,6 +23,11 @@ struct ForearmCutOptions {
   // The hand starts where the width first exceeds this many times the narrowest width
   // seen so far, walking from the arm's end.
   double widen_ratio = 1.3;
+  // Where that leaves no arm before the widening, the profile is read again with the
+  // narrowest taken over the last stretch only, this many narrowest widths long: a hand
+  // widens within its own width, while an adult's arm widens gradually towards the elbow,
+  // and read from its capped far end that widening passes for the hand's (docs/estimator.md).
+  double widen_within = 1.0;
   // An arm is at least this wide relative to the widest part (fingers are narrower): the
   // 90th percentile of the slices' skin along the axis (their pixels, not their extent), as
   // fingers held out sideways make slices far wider than the palm.
