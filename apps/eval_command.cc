@@ -101,6 +101,7 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
                            {"size", {options.study.width, options.study.height}},
                            {"seed", options.study.seed},
                            {"input", options.study.masks ? "masks" : "rgb"},
+                           {"adult_arm", options.study.adult_arm},
                            {"rows", ToJson(scores)}};
     WriteFileAtomic(options.out_dir / (options.name + ".json"), json.dump(2) + "\n");
   }

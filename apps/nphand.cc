@@ -434,6 +434,7 @@ void AddEvalEstimatorCommand(CLI::App* eval, nphand::EvalEstimatorCommandOptions
   cmd->add_option("--seed", s.seed, "Sequence i uses seed + i")->check(WholeNumber())->capture_default_str();
   cmd->add_option("--settings", s.settings, "Settings to run (default: the whole sweep)")->delimiter(',');
   cmd->add_flag("--masks", s.masks, "Estimate from the rendered hand masks (the paper's input) instead of the RGB frames");
+  cmd->add_flag("--adult-arm", s.adult_arm, "Sequences with a forearm render an adult's arm, not the cone sized to the mesh's wrist");
   cmd->add_option("--out", o.out_dir, "Folder for the JSON");
   cmd->add_option("--name", o.name, "File name of the JSON")->capture_default_str();
   cmd->add_flag("--json", json, "Print JSON instead of the table");
@@ -524,6 +525,7 @@ void AddEvalPoseStudyCommands(CLI::App* eval, nphand::EvalPoseStudyCommandOption
     cmd->add_option("--gp-rows", s.gp_rows, "Database entries GP is fitted on")->capture_default_str();
     cmd->add_option("--rvm-rows", s.rvm_rows, "Database entries the RVM starts from")->capture_default_str();
     cmd->add_option("--fit-seed", s.fit_seed, "Seed of the regressions' entries")->check(WholeNumber())->capture_default_str();
+    cmd->add_flag("--adult-arm", s.adult_arm, "The sequences' forearms are an adult's arm, not the cone sized to the mesh's wrist");
     cmd->add_flag("--json", json, "Print one JSON object instead of the tables");
     return cmd;
   };

@@ -1,6 +1,7 @@
 #include "nphand/eval/estimator_study.h"
 
 #include <algorithm>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -68,6 +69,33 @@ TEST_F(EstimatorStudyTest, MasksAreTheRenderedHandsOwn) {
   EXPECT_EQ(scores[0].options["refine"], false);
   EXPECT_EQ(scores[1].options["refine"]["render_side"], 64);
   for (const EstimatorScore& s : scores) EXPECT_GT(s.detected, 0) << s.name;
+}
+
+// The validation sequences vary the forearm (none, bare, sleeved), the background and a
+// face; asked for, the sequences with a forearm render an adult's arm.
+TEST(ValidationSequencesTest, VaryTheSceneAndTakeAnAdultArmWhenAsked) {
+  EstimatorStudyOptions options;
+  const std::vector<SequenceOptions> cone = ValidationSequences(options);
+  options.adult_arm = true;
+  const std::vector<SequenceOptions> adult = ValidationSequences(options);
+  ASSERT_EQ(cone.size(), 24u);
+  ASSERT_EQ(adult.size(), cone.size());
+  std::set<int> forearms, backgrounds;
+  int faces = 0;
+  for (size_t i = 0; i < cone.size(); ++i) {
+    EXPECT_EQ(cone[i].seed, options.seed + i);
+    forearms.insert(static_cast<int>(cone[i].forearm));
+    backgrounds.insert(static_cast<int>(cone[i].background));
+    faces += cone[i].face;
+    EXPECT_FALSE(cone[i].adult_arm);
+    EXPECT_EQ(adult[i].adult_arm, cone[i].forearm != ForearmKind::kNone) << i;
+    EXPECT_EQ(adult[i].forearm, cone[i].forearm);
+    std::string why;
+    EXPECT_TRUE(adult[i].Check(&why)) << why;
+  }
+  EXPECT_EQ(forearms.size(), 3u);
+  EXPECT_EQ(backgrounds.size(), 3u);
+  EXPECT_EQ(faces, 6);
 }
 
 TEST_F(EstimatorStudyTest, RunsTheNamedSettingsOverTheSequences) {

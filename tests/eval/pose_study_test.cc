@@ -43,7 +43,7 @@ TEST(SegmentationNoiseTest, RemovesTheShareAskedThenOpensTheMask) {
 }
 
 TEST(StudySequencesTest, HeldOutAndEachVariantChangesOneThing) {
-  const std::vector<StudySequence> tests = TestSequences(100, 640, 480, 9000);
+  const std::vector<StudySequence> tests = TestSequences(100, 640, 480, 9000, false);
   ASSERT_GE(tests.size(), 4u);
   std::set<uint64_t> seeds;
   for (const StudySequence& s : tests) {
@@ -58,7 +58,7 @@ TEST(StudySequencesTest, HeldOutAndEachVariantChangesOneThing) {
   }
   EXPECT_EQ(seeds.size(), tests.size());
 
-  const std::vector<StudySequence> variants = RobustnessSequences(100, 640, 480, 9100);
+  const std::vector<StudySequence> variants = RobustnessSequences(100, 640, 480, 9100, false);
   ASSERT_GE(variants.size(), 5u);
   const StudySequence& base = variants[0];
   for (size_t v = 1; v < variants.size(); ++v) {
@@ -71,6 +71,20 @@ TEST(StudySequencesTest, HeldOutAndEachVariantChangesOneThing) {
   }
 }
 
+// With `adult_arm` every sequence's forearm is an adult's; otherwise none is.
+TEST(StudySequencesTest, AdultArmsWhenAsked) {
+  for (const bool adult : {false, true}) {
+    std::vector<StudySequence> all = TestSequences(100, 640, 480, 9000, adult);
+    const std::vector<StudySequence> variants = RobustnessSequences(100, 640, 480, 9100, adult);
+    all.insert(all.end(), variants.begin(), variants.end());
+    for (const StudySequence& s : all) {
+      EXPECT_EQ(s.options.adult_arm, adult) << s.name;
+      std::string why;
+      EXPECT_TRUE(s.options.Check(&why)) << s.name << ": " << why;
+    }
+  }
+}
+
 // A database of the test sequences' grasps only, small enough to build in seconds, and
 // the test sequences at a quarter of the pixels.
 class PoseStudyTest : public ::testing::Test {
@@ -79,7 +93,7 @@ class PoseStudyTest : public ::testing::Test {
     path_ = new std::filesystem::path(std::filesystem::temp_directory_path() /
                                       ("nphand_pose_study_" + std::to_string(::getpid()) + ".db"));
     DatabaseBuildOptions options;
-    for (const StudySequence& s : TestSequences(2, 64, 64, 1)) options.grasps.push_back(s.options.grasp);
+    for (const StudySequence& s : TestSequences(2, 64, 64, 1, false)) options.grasps.push_back(s.options.grasp);
     std::sort(options.grasps.begin(), options.grasps.end());
     options.gestures = {};
     options.directions = 96;
@@ -88,7 +102,7 @@ class PoseStudyTest : public ::testing::Test {
     BuildDatabase(RightHand(), options, *path_, nullptr);
     db_ = new Database(Database::Open(*path_));
     index_ = new ExactIndex(DatabaseDescriptors(*db_));
-    sequences_ = new std::vector<RenderedSequence>(RenderSequences(RightHand(), TestSequences(24, 320, 240, 9000), nullptr));
+    sequences_ = new std::vector<RenderedSequence>(RenderSequences(RightHand(), TestSequences(24, 320, 240, 9000, false), nullptr));
   }
   static void TearDownTestSuite() {
     delete sequences_;

@@ -176,6 +176,23 @@ bool EstimatorStudyOptions::Check(std::string* why) const {
   return false;
 }
 
+std::vector<SequenceOptions> ValidationSequences(const EstimatorStudyOptions& options) {
+  std::vector<SequenceOptions> out;
+  for (int s = 0; s < options.sequences; ++s) {
+    SequenceOptions sequence;
+    sequence.frames = options.frames;
+    sequence.width = options.width;
+    sequence.height = options.height;
+    sequence.seed = options.seed + static_cast<uint64_t>(s);
+    sequence.forearm = static_cast<ForearmKind>(s % 3 == 2 ? 0 : 1 + s % 2);
+    sequence.background = static_cast<BackgroundKind>((s / 2) % 3);
+    sequence.face = s % 4 == 3;
+    sequence.adult_arm = options.adult_arm && sequence.forearm != ForearmKind::kNone;
+    out.push_back(sequence);
+  }
+  return out;
+}
+
 std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex& index, const HandModel& hand,
                                               const EstimatorOptions& base, const EstimatorStudyOptions& options,
                                               std::ostream* progress) {
@@ -195,20 +212,12 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
   // The validation frames: sequences that vary everything the estimator must cope with.
   std::vector<std::vector<SequenceFrame>> sequences;
   ProgressLine render_line(progress, "estimator study: rendering", static_cast<uint64_t>(options.sequences), "sequences");
-  for (int s = 0; s < options.sequences; ++s) {
-    SequenceOptions sequence;
-    sequence.frames = options.frames;
-    sequence.width = options.width;
-    sequence.height = options.height;
-    sequence.seed = options.seed + static_cast<uint64_t>(s);
-    sequence.forearm = static_cast<ForearmKind>(s % 3 == 2 ? 0 : 1 + s % 2);
-    sequence.background = static_cast<BackgroundKind>((s / 2) % 3);
-    sequence.face = s % 4 == 3;
+  for (const SequenceOptions& sequence : ValidationSequences(options)) {
     Sequence rendered(hand, sequence);
     std::vector<SequenceFrame> frames;
     for (int i = 0; i < rendered.size(); ++i) frames.push_back(rendered.Render(i));
     sequences.push_back(std::move(frames));
-    render_line.Update(static_cast<uint64_t>(s + 1));
+    render_line.Update(sequences.size());
   }
   render_line.Finish();
 

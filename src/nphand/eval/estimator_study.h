@@ -17,6 +17,7 @@
 #include "nphand/estimate/estimator.h"
 #include "nphand/index/knn_index.h"
 #include "nphand/model/hand_model.h"
+#include "nphand/sequence/sequence.h"
 
 namespace nphand {
 
@@ -37,8 +38,13 @@ struct EstimatorStudyOptions {
   uint64_t seed = 7000;   // sequence i uses seed + i (the evaluation uses other seeds)
   std::vector<std::string> settings;  // names from EstimatorSweep(); empty: all
   bool masks = false;     // the rendered hand's mask (the paper's input) instead of the RGB frame
+  bool adult_arm = false; // sequences with a forearm render an adult's arm (Forearm::Adult()), not the cone
   bool Check(std::string* why) const;
 };
+
+// The validation sequences: sequence i of seed + i, with or without a forearm, bare or
+// sleeved, on each background, a face in every fourth.
+std::vector<SequenceOptions> ValidationSequences(const EstimatorStudyOptions& options);
 
 // A wrist this far from the truth is turned about 180 degrees: the wrist drawn at the
 // fingertips, a silhouette read end for end.

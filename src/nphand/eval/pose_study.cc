@@ -89,7 +89,7 @@ MethodScore Summarise(const std::string& method, const std::string& sequence, do
 
 }  // namespace
 
-std::vector<StudySequence> TestSequences(int frames, int width, int height, uint64_t seed) {
+std::vector<StudySequence> TestSequences(int frames, int width, int height, uint64_t seed, bool adult_arm) {
   struct Plan {
     const char* name;
     int grasp;
@@ -121,12 +121,13 @@ std::vector<StudySequence> TestSequences(int frames, int width, int height, uint
     s.options.skin = plans[i].skin;
     s.options.face = plans[i].face;
     s.options.seed = seed + i;
+    s.options.adult_arm = adult_arm;
     out.push_back(s);
   }
   return out;
 }
 
-std::vector<StudySequence> RobustnessSequences(int frames, int width, int height, uint64_t seed) {
+std::vector<StudySequence> RobustnessSequences(int frames, int width, int height, uint64_t seed, bool adult_arm) {
   StudySequence base;
   base.name = "base";
   base.options.frames = frames;
@@ -138,6 +139,7 @@ std::vector<StudySequence> RobustnessSequences(int frames, int width, int height
   base.options.background = BackgroundKind::kPlain;
   base.options.skin = "medium";
   base.options.seed = seed;
+  base.options.adult_arm = adult_arm;
   std::vector<StudySequence> out = {base};
   auto variant = [&](const char* name, auto change) {
     StudySequence s = base;
@@ -306,6 +308,7 @@ nlohmann::json DescribeSequences(const std::vector<RenderedSequence>& sequences)
                    {"grasp", o.grasp},
                    {"object_scale", o.object_scale},
                    {"forearm", ToString(o.forearm)},
+                   {"adult_arm", o.adult_arm},
                    {"background", ToString(o.background)},
                    {"skin", o.skin},
                    {"face", o.face},
@@ -350,8 +353,9 @@ PoseStudyResult RunPoseStudy(PoseStudyPart part, const Database& db, const KnnIn
   result.part = ToString(part);
   const std::vector<RenderedSequence> sequences = RenderSequences(
       hand,
-      part == PoseStudyPart::kRobustness ? RobustnessSequences(options.frames, options.width, options.height, options.seed + 100)
-                                         : TestSequences(options.frames, options.width, options.height, options.seed),
+      part == PoseStudyPart::kRobustness
+          ? RobustnessSequences(options.frames, options.width, options.height, options.seed + 100, options.adult_arm)
+          : TestSequences(options.frames, options.width, options.height, options.seed, options.adult_arm),
       progress);
   result.sequences = DescribeSequences(sequences);
 

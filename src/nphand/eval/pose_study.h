@@ -44,11 +44,11 @@ struct StudySequence {
 // of sizes the database lacks, a lid and a pen; each grasp closed onto its object afresh,
 // the camera moving and rolling, a forearm in view. Seeds seed, seed + 1, ... (the
 // estimator's validation used 7000-7023; these are never used to choose parameters).
-std::vector<StudySequence> TestSequences(int frames, int width, int height, uint64_t seed);
+std::vector<StudySequence> TestSequences(int frames, int width, int height, uint64_t seed, bool adult_arm);
 // One sequence (the ball) on a plain background with a bare forearm and a medium skin, then
 // variants that each change one thing: a dark and a light skin, a textured background, a
 // sleeve, a hand 10 % longer and narrower.
-std::vector<StudySequence> RobustnessSequences(int frames, int width, int height, uint64_t seed);
+std::vector<StudySequence> RobustnessSequences(int frames, int width, int height, uint64_t seed, bool adult_arm);
 
 // A rendered frame of a study sequence, with what the methods and the measures need.
 struct StudyFrame {
@@ -131,6 +131,7 @@ struct PoseStudyOptions {
   int gp_rows = 2000;
   int rvm_rows = 800;
   uint64_t fit_seed = 1;
+  bool adult_arm = false;          // the sequences' forearms are an adult's arm (Forearm::Adult()), not the cone
   bool Check(std::string* why) const;
 };
 
