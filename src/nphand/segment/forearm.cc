@@ -219,7 +219,7 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
     for (int step = first; step < slices; ++step) {
       const double w = width[index(step)];
       if (step > first) {
-        const double back = within * narrowest;
+        const double back = std::isinf(within) ? step - first : within * narrowest;
         const int stretch_start = back >= step - first ? first : step - std::max(1, static_cast<int>(std::lround(back)));
         while (behind.front() < stretch_start) behind.pop_front();
         if (w > options.widen_ratio * width[index(behind.front())]) {
