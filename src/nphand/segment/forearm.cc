@@ -219,8 +219,8 @@ Reading Read(const std::vector<MaskRun>& runs, cv::Point2d centre, cv::Point2d a
     for (int step = first; step < slices; ++step) {
       const double w = width[index(step)];
       if (step > first) {
-        const double back = std::isinf(within) ? step - first : within * narrowest;
-        const int stretch_start = back >= step - first ? first : step - std::max(1, static_cast<int>(std::lround(back)));
+        const int stretch_start =
+            std::isinf(within) ? first : std::max(first, step - std::max(1, static_cast<int>(std::lround(within * narrowest))));
         while (behind.front() < stretch_start) behind.pop_front();
         if (w > options.widen_ratio * width[index(behind.front())]) {
           hand_start = step;
