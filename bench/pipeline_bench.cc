@@ -1,7 +1,8 @@
 // Google Benchmark of the estimator's stages that need no database: skin segmentation of a
-// 640x480 camera-like frame, the forearm cut, the descriptor of the hand's crop, and the
-// temporal prior over K = 500 hypotheses. The whole path, search included, is `nphand bench
-// pipeline`; the search alone is index_bench. OpenCV runs on one thread, as there.
+// 640x480 camera-like frame, the picture within it, the forearm cut, the descriptor of the
+// hand's crop, and the temporal prior over K = 500 hypotheses. The whole path, search
+// included, is `nphand bench pipeline`; the search alone is index_bench. OpenCV runs on one
+// thread, as there.
 #include <benchmark/benchmark.h>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -9,6 +10,7 @@
 #include "nphand/estimate/estimator.h"
 #include "nphand/features/descriptor.h"
 #include "nphand/segment/forearm.h"
+#include "nphand/segment/picture.h"
 #include "nphand/segment/skin.h"
 #include "nphand/sequence/sequence.h"
 #include "nphand/util/check.h"
@@ -79,6 +81,18 @@ void BM_ForearmCut(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(CutForearm(region, 0).cut);
 }
 BENCHMARK(BM_ForearmCut)->Unit(benchmark::kMicrosecond);
+
+// The picture within the frame: a camera's frame has no bars (arg 0), a pillarboxed one
+// has (arg 1: the frame's outer eighths black).
+void BM_PictureOf(benchmark::State& state) {
+  cv::Mat frame = Frame().rgb.clone();
+  if (state.range(0) == 1) {
+    frame.colRange(0, frame.cols / 8).setTo(cv::Scalar::all(0));
+    frame.colRange(frame.cols - frame.cols / 8, frame.cols).setTo(cv::Scalar::all(0));
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(PictureOf(frame).area());
+}
+BENCHMARK(BM_PictureOf)->ArgName("bars")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 void BM_Describe(benchmark::State& state) {
   const cv::Mat hand = Frame().labels == static_cast<int>(PixelLabel::kHand);

@@ -16,6 +16,7 @@
 #include "nphand/index/backends.h"
 #include "nphand/scene/gesture.h"
 #include "nphand/scene/viewpoint.h"
+#include "nphand/segment/picture.h"
 #include "nphand/sequence/sequence.h"
 #include "testing/testing.h"
 
@@ -957,6 +958,34 @@ TEST_F(EstimatorTest, ARegionOfInterestConfinesTheSearch) {
   EXPECT_EQ(r.status, FrameStatus::kNoSkin);
   EXPECT_EQ(r.reason, "no skin-coloured region within the region of interest");
   testing::ExpectError([&] { estimator.Process(bgr, 0.0, cv::Rect(700, 0, 50, 50)); }, "does not meet the 640 x 240 frame");
+}
+
+// A letterboxed and pillarboxed frame: its picture, the hand and a short stretch of its arm,
+// between black bars. The arm leaves the picture at its edge, as it would the frame's, so
+// a stretch under min_arm_length arm widths is cut as an arm entering from outside.
+TEST_F(EstimatorTest, AnArmLeavingABoxedPictureIsCutAtTheBar) {
+  SequenceOptions settings = SmallSequence(1);
+  settings.width = 640;
+  settings.distance_m = 0.6;
+  const SequenceFrame frame = Sequence(RightHand(), settings).Render(0);
+  const cv::Rect hand = cv::boundingRect(frame.labels == static_cast<int>(PixelLabel::kHand));
+  const cv::Rect picture = cv::Rect(hand.x - 20, hand.y - 20, hand.width + 40, hand.height + 40) & cv::Rect(0, 0, 640, 240);
+  ASSERT_GT(cv::countNonZero(frame.labels(picture) == static_cast<int>(PixelLabel::kForearm)), 0) << "the arm leaves the picture";
+  const cv::Point at(60, 40);
+  cv::Mat boxed = cv::Mat::zeros(picture.height + 2 * at.y, picture.width + 2 * at.x, CV_8UC3);
+  frame.rgb(picture).copyTo(boxed(cv::Rect(at, picture.size())));
+  // (The scene's own dark bottom rows may pass for the lower bar's.)
+  const cv::Rect found = PictureOf(boxed);
+  ASSERT_EQ(found & cv::Rect(at, picture.size()), found);
+  ASSERT_EQ(found.tl(), at);
+  ASSERT_EQ(found.width, picture.width);
+  Estimator estimator(*db_, *index_, RightHand(), Options());
+  const FrameResult r = estimator.Process(boxed, 0.0);
+  ASSERT_TRUE(r.detected()) << r.reason;
+  EXPECT_TRUE(r.forearm_cut) << "the arm ends at the bar";
+  const cv::Rect hand_in_box = hand - picture.tl() + at;
+  EXPECT_GT((r.box & hand_in_box).area(), 0.8 * hand_in_box.area());
+  EXPECT_LT(r.box.area(), 1.3 * hand_in_box.area());
 }
 
 // In a track the entries seen from the viewpoints nearest the last frame's best join the

@@ -12,6 +12,7 @@
 #include "nphand/features/descriptor.h"
 #include "nphand/scene/gesture.h"
 #include "nphand/scene/viewpoint.h"
+#include "nphand/segment/picture.h"
 #include "nphand/segment/regions.h"
 #include "nphand/util/check.h"
 #include "nphand/util/parallel.h"
@@ -62,8 +63,8 @@ cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, const cv::
   return mask(tight);
 }
 
-// Which sides of `box` lie on the edges of `view` (the frame, or the caller's region of
-// interest): bit 0 left, 1 top, 2 right, 3 bottom (see CutForearm).
+// Which sides of `box` lie on the edges of `view` (the frame's picture, or the caller's
+// region of interest within it): bit 0 left, 1 top, 2 right, 3 bottom (see CutForearm).
 int Border(const cv::Rect& box, const cv::Rect& view) {
   return (box.x == view.x ? 1 : 0) | (box.y == view.y ? 2 : 0) | (box.x + box.width == view.x + view.width ? 4 : 0) |
          (box.y + box.height == view.y + view.height ? 8 : 0);
@@ -469,9 +470,11 @@ void Estimator::Smooth(FrameResult* r) {
 FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::optional<cv::Rect>& roi) {
   const Clock::time_point start = Clock::now();
   const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect view = roi.has_value() ? *roi & frame : frame;
+  cv::Rect view = roi.has_value() ? *roi & frame : frame;
   NPHAND_THROW_CHECK(!roi.has_value() || view.area() > 0, "estimator: the region of interest (", roi->x, ", ", roi->y, ", ",
                      roi->width, " x ", roi->height, ") does not meet the ", bgr.cols, " x ", bgr.rows, " frame");
+  // Within the picture: an arm leaving it ends at a black bar, which is the frame's edge.
+  if (const cv::Rect within = view & PictureOf(bgr); within.area() > 0) view = within;
   FrameResult result;
   result.frame = frame_++;
   result.time_s = time_s;
