@@ -962,7 +962,8 @@ TEST_F(EstimatorTest, ARegionOfInterestConfinesTheSearch) {
 
 // A letterboxed and pillarboxed frame: its picture, the hand and a short stretch of its arm,
 // between black bars. The arm leaves the picture at its edge, as it would the frame's, so
-// a stretch under min_arm_length arm widths is cut as an arm entering from outside.
+// a stretch under min_arm_length arm widths is cut as an arm entering from outside (between
+// grey bars it is not).
 TEST_F(EstimatorTest, AnArmLeavingABoxedPictureIsCutAtTheBar) {
   SequenceOptions settings = SmallSequence(1);
   settings.width = 640;
@@ -980,12 +981,26 @@ TEST_F(EstimatorTest, AnArmLeavingABoxedPictureIsCutAtTheBar) {
   ASSERT_EQ(found.tl(), at);
   ASSERT_EQ(found.width, picture.width);
   Estimator estimator(*db_, *index_, RightHand(), Options());
-  const FrameResult r = estimator.Process(boxed, 0.0);
+  FrameResult r = estimator.Process(boxed, 0.0);
   ASSERT_TRUE(r.detected()) << r.reason;
   EXPECT_TRUE(r.forearm_cut) << "the arm ends at the bar";
   const cv::Rect hand_in_box = hand - picture.tl() + at;
   EXPECT_GT((r.box & hand_in_box).area(), 0.8 * hand_in_box.area());
   EXPECT_LT(r.box.area(), 1.3 * hand_in_box.area());
+  // So it is within a region of interest reaching into the bars.
+  estimator.Reset();
+  r = estimator.Process(boxed, 0.0, cv::Rect(at / 2, picture.size() + cv::Size(at.x, at.y)));
+  ASSERT_TRUE(r.detected()) << r.reason;
+  EXPECT_TRUE(r.forearm_cut);
+  // The same picture between grey bars is the whole frame: its short arm ends within it,
+  // and stays on.
+  cv::Mat grey_bars(boxed.size(), CV_8UC3, cv::Scalar::all(128));
+  frame.rgb(picture).copyTo(grey_bars(cv::Rect(at, picture.size())));
+  ASSERT_EQ(PictureOf(grey_bars), cv::Rect(cv::Point(0, 0), grey_bars.size()));
+  estimator.Reset();
+  r = estimator.Process(grey_bars, 0.0);
+  ASSERT_TRUE(r.detected()) << r.reason;
+  EXPECT_FALSE(r.forearm_cut) << "an arm this short within the frame is no arm";
 }
 
 // In a track the entries seen from the viewpoints nearest the last frame's best join the

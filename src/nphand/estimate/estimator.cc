@@ -43,7 +43,8 @@ constexpr double kStrayShare = 0.05;
 // kPieceShare of its pixels, whose boxes meet the region's box grown by 30 % of its longer
 // side): their pixels within `*box`, which gets the pixels' bounds. `pieces`: whether
 // to gather them (false: the region alone); `gathered` (if not null) gets the pieces' pixels.
-// Only pixels within `view` count (the frame, or the caller's region of interest).
+// Only pixels within `view` count (the frame's picture between black bars, or the caller's
+// region of interest within it).
 cv::Mat GatherHand(const SkinSegmentation& s, const SkinRegion& seed, const cv::Rect& view, bool pieces, cv::Rect* box,
                    int* gathered) {
   const cv::Rect reach = HandReach(seed.box & view);
@@ -470,10 +471,12 @@ void Estimator::Smooth(FrameResult* r) {
 FrameResult Estimator::Detect(const cv::Mat& bgr, double time_s, const std::optional<cv::Rect>& roi) {
   const Clock::time_point start = Clock::now();
   const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
+  NPHAND_THROW_CHECK(!bgr.empty() && bgr.type() == CV_8UC3, "estimator: a frame must be a non-empty 8-bit BGR image");
   cv::Rect view = roi.has_value() ? *roi & frame : frame;
   NPHAND_THROW_CHECK(!roi.has_value() || view.area() > 0, "estimator: the region of interest (", roi->x, ", ", roi->y, ", ",
                      roi->width, " x ", roi->height, ") does not meet the ", bgr.cols, " x ", bgr.rows, " frame");
-  // Within the picture: an arm leaving it ends at a black bar, which is the frame's edge.
+  // Within the picture: an arm leaving it ends at a black bar, which is the frame's edge. A
+  // region of interest wholly within a bar stays as it is (it has no skin).
   if (const cv::Rect within = view & PictureOf(bgr); within.area() > 0) view = within;
   FrameResult result;
   result.frame = frame_++;

@@ -248,11 +248,13 @@ class Estimator {
   // a hand model of another asset, or a database of the other hand.
   Estimator(const Database& db, const KnnIndex& index, const HandModel& hand, const EstimatorOptions& options);
 
-  // The next frame (8-bit BGR) of a video at `time_s`. With `roi` (frame pixels: a box from
-  // the caller's own detector or tracker, or a fixed workspace) the hand is sought there
-  // only: skin regions that do not meet it are no candidates, the others are clipped to it,
-  // and its edges count as the frame's (an arm clipped there enters from an edge). Throws
-  // nphand::Error for a box that does not meet the frame.
+  // The next frame (8-bit BGR) of a video at `time_s`. In a letterboxed or pillarboxed
+  // frame the hand is sought in the picture between its black bars, whose edges count as
+  // the frame's (`PictureOf`). With `roi` (frame pixels: a box from the caller's own
+  // detector or tracker, or a fixed workspace) the hand is sought there only (within the
+  // picture): skin regions that do not meet it are no candidates, the others are clipped to
+  // it, and its edges count as the frame's (an arm clipped there enters from an edge).
+  // Throws nphand::Error for another image or a box that does not meet the frame.
   FrameResult Process(const cv::Mat& bgr, double time_s, const std::optional<cv::Rect>& roi = std::nullopt);
   // The same from a hand mask (CV_8UC1, non-zero = hand) instead of a frame: no
   // segmentation, no region choice, no forearm cut.

@@ -13,23 +13,33 @@ namespace {
 // The share of the `count` pixels from `at`, `step` bytes apart, that are dark.
 double DarkShare(const uint8_t* at, int count, size_t step) {
   int dark = 0;
-  for (int i = 0; i < count; ++i, at += step) dark += std::max({at[0], at[1], at[2]}) <= kBarLevel;
+  for (int i = 0; i < count; ++i) {
+    const uint8_t* pixel = at + i * step;
+    dark += std::max({pixel[0], pixel[1], pixel[2]}) <= kBarLevel;
+  }
   return static_cast<double>(dark) / count;
 }
 
-// Where the picture starts along one side, in lines from the frame's edge (0: no bar). Line
-// i of the side's `lines` starts at `first + i * next` and runs `count` pixels `step` bytes
-// apart.
-int PictureStart(const uint8_t* first, ptrdiff_t next, int lines, int count, size_t step) {
+// One side's bar, in lines from the frame's edge: its depth (0: no bar) and where the
+// picture starts past its edge.
+struct Bar {
+  int depth = 0;
+  int start = 0;
+};
+
+// The bar along one side of `lines` lines: line i starts at `first + i * next` and is read
+// over `count` pixels `step` bytes apart.
+Bar BarAlong(const uint8_t* first, ptrdiff_t next, int lines, int count, size_t step) {
   const int most = static_cast<int>(kBarMost * lines);
   int depth = 0;
   while (depth < most && DarkShare(first + depth * next, count, step) >= kBarShare) ++depth;
-  if (depth < kBarLeast || depth >= most) return 0;
+  if (depth < kBarLeast || depth >= most) return {};
+  // depth + edge <= lines (kBarMost + kBarEdge < 1, and a bar needs lines >= 8).
   const int edge = std::max(kBarEdgeLeast, static_cast<int>(kBarEdge * lines));
-  for (int line = depth; line <= std::min(depth + edge, lines - 1); ++line) {
-    if (DarkShare(first + line * next, count, step) <= kPictureDark) return line;
+  for (int line = depth; line < depth + edge; ++line) {
+    if (DarkShare(first + line * next, count, step) <= kPictureDark) return {depth, line};
   }
-  return 0;
+  return {};
 }
 
 }  // namespace
@@ -39,20 +49,28 @@ cv::Rect PictureOf(const cv::Mat& bgr) {
   const int w = bgr.cols, h = bgr.rows;
   const size_t row = bgr.step[0], pixel = 3;
   const ptrdiff_t back_row = -static_cast<ptrdiff_t>(row), back_pixel = -static_cast<ptrdiff_t>(pixel);
-  // Each side's lines are read over the middle third of their length, which the bars across
-  // them (each under kBarMost of the frame) leave alone.
-  const int rows = std::max(1, h / 3), cols = std::max(1, w / 3);
-  const uint8_t* middle_rows = bgr.ptr<uint8_t>(h / 3);
-  const uint8_t* middle_cols = bgr.ptr<uint8_t>(0) + (w / 3) * pixel;
-  const int left = PictureStart(middle_rows, pixel, w, rows, row);
-  const int right = PictureStart(middle_rows + (w - 1) * pixel, back_pixel, w, rows, row);
-  const int top = PictureStart(middle_cols, row, h, cols, pixel);
-  const int bottom = PictureStart(middle_cols + (h - 1) * row, back_row, h, cols, pixel);
+  // Each side's lines are read where no bar across them can reach: past kBarMost of the
+  // side from either end (the middle fifth), at least one pixel.
+  const int skip_rows = std::min(static_cast<int>(kBarMost * h), (h - 1) / 2);
+  const int skip_cols = std::min(static_cast<int>(kBarMost * w), (w - 1) / 2);
+  const int rows = h - 2 * skip_rows, cols = w - 2 * skip_cols;
+  const uint8_t* middle_rows = bgr.ptr<uint8_t>(skip_rows);
+  const uint8_t* middle_cols = bgr.ptr<uint8_t>(0) + skip_cols * pixel;
+  const Bar left = BarAlong(middle_rows, pixel, w, rows, row);
+  const Bar right = BarAlong(middle_rows + (w - 1) * pixel, back_pixel, w, rows, row);
+  const Bar top = BarAlong(middle_cols, row, h, cols, pixel);
+  const Bar bottom = BarAlong(middle_cols + (h - 1) * row, back_row, h, cols, pixel);
   // Bars come in pairs about the picture: one alone is a dark scene's side.
-  auto paired = [](int a, int b, int side) { return a > 0 && b > 0 && std::abs(a - b) <= kBarPairing * side; };
+  auto paired = [](const Bar& a, const Bar& b, int side) {
+    return a.depth > 0 && b.depth > 0 && std::abs(a.depth - b.depth) <= kBarPairing * side;
+  };
   const bool across = paired(left, right, w), down = paired(top, bottom, h);
-  const cv::Rect picture(across ? left : 0, down ? top : 0, across ? w - left - right : w, down ? h - top - bottom : h);
-  return picture.width > 0 && picture.height > 0 ? picture : cv::Rect(0, 0, w, h);
+  const cv::Rect picture(across ? left.start : 0, down ? top.start : 0, across ? w - left.start - right.start : w,
+                         down ? h - top.start - bottom.start : h);
+  // Each side's start is the first line no more than kPictureDark dark, the lines before it
+  // darker, read over the same pixels from both sides: the starts cannot cross.
+  NPHAND_CHECK(picture.width > 0 && picture.height > 0, "picture: the bars' starts crossed");
+  return picture;
 }
 
 }  // namespace nphand
