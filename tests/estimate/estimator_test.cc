@@ -973,8 +973,13 @@ TEST_F(EstimatorTest, AnArmLeavingABoxedPictureIsCutAtTheBar) {
   const cv::Rect picture = cv::Rect(hand.x - 20, hand.y - 20, hand.width + 40, hand.height + 40) & cv::Rect(0, 0, 640, 240);
   ASSERT_GT(cv::countNonZero(frame.labels(picture) == static_cast<int>(PixelLabel::kForearm)), 0) << "the arm leaves the picture";
   const cv::Point at(60, 40);
-  cv::Mat boxed = cv::Mat::zeros(picture.height + 2 * at.y, picture.width + 2 * at.x, CV_8UC3);
-  frame.rgb(picture).copyTo(boxed(cv::Rect(at, picture.size())));
+  // The picture at `at` between bars of `colour`.
+  auto between = [&](const cv::Scalar& colour) {
+    cv::Mat framed(picture.height + 2 * at.y, picture.width + 2 * at.x, CV_8UC3, colour);
+    frame.rgb(picture).copyTo(framed(cv::Rect(at, picture.size())));
+    return framed;
+  };
+  const cv::Mat boxed = between(cv::Scalar::all(0));
   // (The scene's own dark bottom rows may pass for the lower bar's.)
   const cv::Rect found = PictureOf(boxed);
   ASSERT_EQ(found & cv::Rect(at, picture.size()), found);
@@ -994,8 +999,7 @@ TEST_F(EstimatorTest, AnArmLeavingABoxedPictureIsCutAtTheBar) {
   EXPECT_TRUE(r.forearm_cut);
   // The same picture between grey bars is the whole frame: its short arm ends within it,
   // and stays on.
-  cv::Mat grey_bars(boxed.size(), CV_8UC3, cv::Scalar::all(128));
-  frame.rgb(picture).copyTo(grey_bars(cv::Rect(at, picture.size())));
+  const cv::Mat grey_bars = between(cv::Scalar::all(128));
   ASSERT_EQ(PictureOf(grey_bars), cv::Rect(cv::Point(0, 0), grey_bars.size()));
   estimator.Reset();
   r = estimator.Process(grey_bars, 0.0);

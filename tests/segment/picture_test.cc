@@ -8,23 +8,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "nphand/sequence/background.h"
 #include "testing/testing.h"
 
 namespace nphand {
 namespace {
 
-// A textured scene of `size` (BGR, every pixel brighter than a bar), with a few dark spots.
-cv::Mat Scene(cv::Size size, uint64_t seed) {
-  cv::Mat scene(size, CV_8UC3);
-  cv::RNG rng(seed);
-  rng.fill(scene, cv::RNG::UNIFORM, cv::Scalar::all(60), cv::Scalar::all(255));
-  cv::GaussianBlur(scene, scene, cv::Size(5, 5), 0.0);
-  for (int i = 0; i < 20; ++i) {
-    cv::circle(scene, cv::Point(rng.uniform(0, size.width), rng.uniform(0, size.height)), rng.uniform(2, 8),
-               cv::Scalar::all(10), cv::FILLED);
-  }
-  return scene;
-}
+// A cluttered room of `size` (BGR), as the rendered sequences' backgrounds are.
+cv::Mat Scene(cv::Size size, uint64_t seed) { return MakeBackground(BackgroundKind::kClutter, size, seed); }
 
 // `picture` in a black frame of `frame`, at `at`, through JPEG (its noise lifts the bars'
 // pixels and blurs their edges).
