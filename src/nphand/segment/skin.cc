@@ -126,6 +126,20 @@ std::vector<uint8_t> LabelsMeeting(const cv::Mat& labels, int count, const cv::M
   return meets;
 }
 
+// Labels the 4-connected pieces of `mask` (CV_8UC1) into `labels` (CV_32SC1) and returns
+// their count (the background's label 0 included), with each label's pixels in `areas`:
+// cv::connectedComponentsWithStats's labels and areas, for its labelling's cost (its
+// statistics cost several times that).
+int LabelPieces(const cv::Mat& mask, cv::Mat* labels, std::vector<int>* areas) {
+  const int count = cv::connectedComponents(mask, *labels, 4, CV_32S);
+  areas->assign(count, 0);
+  for (int y = 0; y < labels->rows; ++y) {
+    const int* label = labels->ptr<int>(y);
+    for (int x = 0; x < labels->cols; ++x) ++(*areas)[label[x]];
+  }
+  return count;
+}
+
 // The rim's pieces (`rim`, CV_8UC1, 255 = rim chroma; marked in passing) that meet `skin`
 // (8-connected) and cover at most `largest` pixels, added to `skin`. Only the pieces that
 // meet skin are visited, each once.
@@ -178,10 +192,11 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   for (const cv::Rect& c : centres) widest = std::max(widest, 2 * c.width);
   const int k = std::max(3, widest / 12) | 1;
   cv::morphologyEx(pieces, pieces, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
-  cv::Mat labels, stats, centroids;
+  cv::Mat labels;
+  std::vector<int> areas;
   // 4-connected, not LabelRegions' 8: pieces an outline parts that still touch at a corner
   // stay apart.
-  const int count = cv::connectedComponentsWithStats(pieces, labels, stats, centroids, 4, CV_32S);
+  const int count = LabelPieces(pieces, &labels, &areas);
   if (count <= 1) return in_front;
   // Pixels by label of `of` (`n` labels) within each centre.
   auto in_centres = [&](const cv::Mat& of, int n) {
@@ -217,7 +232,7 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
     uint8_t* of_face = face_pieces.ptr<uint8_t>(y);
     for (int x = 0; x < labels.cols; ++x) {
       if (label[x] == 0) continue;
-      const bool small = stats.at<int>(label[x], cv::CC_STAT_AREA) < least && goes_on[label[x]] == 0;
+      const bool small = areas[label[x]] < least && goes_on[label[x]] == 0;
       (face[label[x]] != 0 || small ? of_face : keep)[x] = 255;
     }
   }
@@ -243,9 +258,9 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   // outside the shapes (an arm) and of which less than kWholeShare was kept, is kept whole
   // (kInFrontWhole), unless it holds more of a face's centre than the face's piece does (a
   // face's own features shred it too, and its piece is then a part of it).
-  cv::Mat rest_labels, rest_stats, rest_centroids;
-  const int rests =
-      cv::connectedComponentsWithStats(head_skin & ~face_zone, rest_labels, rest_stats, rest_centroids, 4, CV_32S);
+  cv::Mat rest_labels;
+  std::vector<int> rest_areas;
+  const int rests = LabelPieces(head_skin & ~face_zone, &rest_labels, &rest_areas);
   std::vector<uint8_t> arm = LabelsMeeting(rest_labels, rests, outside);
   arm[0] = 0;
   const std::vector<std::vector<int>> rest_centre = in_centres(rest_labels, rests);
@@ -259,7 +274,7 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
     const uint8_t* in = front.ptr<uint8_t>(y);
     for (int x = 0; x < labels.cols; ++x) covered[rest[x]] += in[x] != 0;
   }
-  for (int r = 1; r < rests; ++r) arm[r] &= covered[r] < kWholeShare * rest_stats.at<int>(r, cv::CC_STAT_AREA) ? 1 : 0;
+  for (int r = 1; r < rests; ++r) arm[r] &= covered[r] < kWholeShare * rest_areas[r] ? 1 : 0;
   for (int y = 0; y < labels.rows; ++y) {
     const int* rest = rest_labels.ptr<int>(y);
     uint8_t* in = front.ptr<uint8_t>(y);
@@ -365,7 +380,9 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       cv::morphologyEx(out.skin, out.skin, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
     }
   };
-  classify(nullptr);
+  // The fixed model's skin is classified first only where the cascade looks (it looks
+  // around that skin's regions) or where no face's chroma gates it (below).
+  bool classified = false;
 
   // Faces: looked for every face_interval frames, at once when a region that could hold
   // one came into view on the last frame (someone came in; a hand split by its object, or
@@ -421,6 +438,8 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     return true;
   };
   if (detector_ != nullptr && look) {
+    classify(nullptr);
+    classified = true;
     // The faces followed so far that still match where they were: the cascade misses a face
     // a hand covers in part, and such a face is kept.
     std::vector<cv::Rect> followed;
@@ -487,8 +506,12 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       for (const cv::Rect& box : faces_) boxes.push_back(working_box(box));
       return boxes;
     }());
-    if (face) classify(&*face);
+    if (face) {
+      classify(&*face);
+      classified = true;
+    }
   }
+  if (!classified) classify(nullptr);
   // Each face's head (an ellipse about its box) and, with `necks`, neck (a rectangle
   // below), grown by `grow` faces' widths, drawn into `mask` (working pixels); returns their
   // bounds.
