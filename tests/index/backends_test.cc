@@ -195,7 +195,17 @@ TEST_P(BackendTest, DistancesToChosenEntriesAreTheSearchsOwn) {
   std::vector<float> untouched = {7.0f};
   testing::ExpectError([&] { index->Distances(QueryOf(all.ids[0]), std::vector<entry_id_t>{all.ids[1]}, &untouched); },
                        "entry " + std::to_string(all.ids[1]) + " is not in the index");
+  const entry_id_t beyond = all.ids.back() + 1000;  // past the largest entry held
+  testing::ExpectError([&] { index->Distances(QueryOf(all.ids[0]), std::vector<entry_id_t>{beyond}, &untouched); },
+                       "entry " + std::to_string(beyond) + " is not in the index");
   EXPECT_EQ(untouched, std::vector<float>{7.0f});
+}
+
+// An index's entries are ascending, as the database's are: a set out of order is refused.
+TEST_P(BackendTest, EntriesOutOfOrderAreRefused) {
+  IndexedSet set = Half(DatabaseDescriptors(db()), 0);
+  std::swap(set.ids[0], set.ids[1]);
+  testing::ExpectError([&] { BuildIndex(std::move(set), GetParam().approximate); }, "its entries must be ascending");
 }
 
 INSTANTIATE_TEST_SUITE_P(All, BackendTest, ::testing::ValuesIn(Cases()), [](const auto& info) {

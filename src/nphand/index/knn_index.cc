@@ -53,6 +53,13 @@ void CheckQuery(const DescriptorConfig& config, const Descriptor& query) {
 
 }  // namespace
 
+KnnIndex::KnnIndex(IndexedSet set) : set_(std::move(set)) {
+  NPHAND_THROW_CHECK(std::adjacent_find(set_.ids.begin(), set_.ids.end(), std::greater_equal<>()) == set_.ids.end(),
+                     "index: its entries must be ascending");
+  row_of_.assign(set_.ids.empty() ? 0 : static_cast<size_t>(set_.ids.back()) + 1, kNoRow);
+  for (size_t row = 0; row < set_.ids.size(); ++row) row_of_[set_.ids[row]] = static_cast<uint32_t>(row);
+}
+
 Neighbours KnnIndex::Search(const Descriptor& query, int k) const {
   NPHAND_THROW_CHECK(k >= 1, "search: k must be at least 1, not ", k);
   CheckQuery(config(), query);
@@ -68,9 +75,8 @@ bool KnnIndex::Distances(const Descriptor& query, std::span<const entry_id_t> id
   CheckQuery(config(), query);
   std::vector<uint32_t> rows(ids.size());
   for (size_t i = 0; i < ids.size(); ++i) {
-    const auto at = std::lower_bound(set_.ids.begin(), set_.ids.end(), ids[i]);
-    NPHAND_THROW_CHECK(at != set_.ids.end() && *at == ids[i], "search: entry ", ids[i], " is not in the index");
-    rows[i] = static_cast<uint32_t>(at - set_.ids.begin());
+    rows[i] = ids[i] < row_of_.size() ? row_of_[ids[i]] : kNoRow;
+    NPHAND_THROW_CHECK(rows[i] != kNoRow, "search: entry ", ids[i], " is not in the index");
   }
   std::vector<float> distances(ids.size());
   if (!RowDistances(query.values, rows, distances.data())) return false;

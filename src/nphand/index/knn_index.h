@@ -85,7 +85,7 @@ class KnnIndex {
   void Save(const std::filesystem::path& path, const Database& db) const;
 
  protected:
-  explicit KnnIndex(IndexedSet set) : set_(std::move(set)) {}
+  explicit KnnIndex(IndexedSet set);
   const IndexedSet& set() const { return set_; }
   // The k nearest rows of the set: (squared distance, row), ascending, ties by row.
   virtual std::vector<std::pair<float, uint32_t>> SearchRows(std::span<const float> query, int k) const = 0;
@@ -96,6 +96,11 @@ class KnnIndex {
 
  private:
   IndexedSet set_;
+  // By entry id, up to the largest the set holds: its row, or kNoRow. Distances looks up a
+  // track's thousand-odd entries a frame; a binary search of the ids cost a quarter of a
+  // millisecond of it (their cache misses), this table (4 bytes an entry) a few microseconds.
+  static constexpr uint32_t kNoRow = UINT32_MAX;
+  std::vector<uint32_t> row_of_;
 };
 
 }  // namespace nphand
