@@ -61,13 +61,15 @@ TEST(BuilderTest, GesturesFollowTheGraspsWithoutAnObject) {
   const Database db = Database::Open(dir / "gestures.db");
   EXPECT_EQ(db.header()["gestures"], nlohmann::json::array({GestureByName("peace").id, GestureByName("fist").id}));
   EXPECT_EQ(db.header()["gesture_names"], nlohmann::json::array({"peace", "fist"}));
-  // A build without gestures writes the header of the files before them: these fields, this order.
+  // A build without gestures writes the header of the files before them, with the fingertips'
+  // keypoint_tips since: these fields, this order.
   const nlohmann::json before = TinyDatabaseOptions().Header();
   std::vector<std::string> keys;
   for (const auto& [key, value] : before.items()) keys.push_back(key);
   EXPECT_EQ(keys, (std::vector<std::string>{"crop", "entries", "format", "grasp_objects", "grasps", "hand",
-                                            "hand_asset_sha256", "hog", "order", "record_bytes", "render", "steps",
-                                            "total_entries", "view_sphere", "view_sphere_coverage", "viewpoints"}));
+                                            "hand_asset_sha256", "hog", "keypoint_tips", "order", "record_bytes",
+                                            "render", "steps", "total_entries", "view_sphere", "view_sphere_coverage",
+                                            "viewpoints"}));
   EXPECT_EQ(before["order"], "((grasp * steps + step) * 2 + with_object) * viewpoints + viewpoint");
   const auto peace = GestureSteps(GestureByName("peace")), fist = GestureSteps(GestureByName("fist"));
   for (size_t i = 160; i < db.size(); ++i) {

@@ -18,6 +18,8 @@
 #include "nphand/scene/viewpoint.h"
 #include "nphand/segment/picture.h"
 #include "nphand/sequence/sequence.h"
+#include "nphand/util/io.h"
+#include "testing/db_files.h"
 #include "testing/testing.h"
 
 namespace nphand {
@@ -169,6 +171,28 @@ TEST_F(EstimatorTest, AGestureIsNamedFromADatabaseWithGestures) {
       EXPECT_EQ(FingerStates(RightHand().KeypointsOf(result.pose)), gesture.extended) << name;
     }
   }
+}
+
+// The model's hand length runs to the middle fingertip's keypoint, at the finger's end; a
+// database from before the fingertips moved there (no keypoint_tips in its header) holds
+// shorter ones, and the estimator refuses it by saying so rather than misjudge distances.
+TEST_F(EstimatorTest, TheHandLengthRunsToTheFingertipAndAnOlderDatabaseIsRefused) {
+  EXPECT_NEAR(ModelHandLength(*db_), HandLength(RightHand().bind_keypoints()), 1e-6);
+  const JointPositions& j = RightHand().bind_joint_positions();
+  const double along_joints = (j[Index(Joint::kMiddleProximal)] - j[0]).norm() +
+                              (j[Index(Joint::kMiddleIntermediate)] - j[Index(Joint::kMiddleProximal)]).norm() +
+                              (j[Index(Joint::kMiddleDistal)] - j[Index(Joint::kMiddleIntermediate)]).norm() +
+                              (j[Index(Joint::kMiddleTip)] - j[Index(Joint::kMiddleDistal)]).norm();
+  EXPECT_NEAR(ModelHandLength(*db_) - along_joints,
+              (RightHand().bind_keypoints()[12] - j[Index(Joint::kMiddleTip)]).norm(), 1e-6);
+  nlohmann::json header = testing::HeaderOf(ReadFileBytes(Path()));
+  header.erase("keypoint_tips");
+  const std::filesystem::path older = testing::ScratchDir() / "older.db";
+  WriteFileAtomic(older, testing::WithHeader(ReadFileBytes(Path()), header));
+  const Database db = Database::Open(older);
+  testing::ExpectError([&] { ModelHandLength(db); }, "make it again with `nphand db build`");
+  testing::ExpectError([&] { Estimator(db, *index_, RightHand(), Options()); },
+                       "fingertip keypoints are the hand asset's tip joints");
 }
 
 TEST_F(EstimatorTest, KeypointsAndDistanceArePlacedInTheFrame) {

@@ -120,6 +120,49 @@ TEST(HandModelTest, ReproportionedHandIsLongerAndNarrowerAndStillRigged) {
   EXPECT_THROW(hand.Reproportioned(1.0, std::nan("")), Error);
 }
 
+// A fingertip keypoint lies at the finger's end, where labelled hands put it: past the
+// asset's tip joint (midway along the last bone), as far along that bone as its skin
+// reaches; the other keypoints are their joints. In any pose and proportions it stays at
+// that end of the bone, and the tip joints move no skin (so moving them moves nothing else).
+TEST(HandModelTest, FingertipKeypointsLieAtTheFingersEnds) {
+  for (const HandModel& hand : {RightHand(), LeftHand(), RightHand().Reproportioned(1.1, 0.9)}) {
+    const Keypoints3d& keypoints = hand.bind_keypoints();
+    const JointPositions& joints = hand.bind_joint_positions();
+    for (int k = 0; k < kNumKeypoints; ++k) {
+      const int joint = Index(KeypointJoint(k));
+      if (k % 4 != 0 || k == 0) {
+        EXPECT_EQ(keypoints[k], joints[joint]) << KeypointName(k);
+        continue;
+      }
+      EXPECT_TRUE(hand.VerticesMovedBy(joint, 1e-6f).empty()) << KeypointName(k);
+      const Eigen::Vector3d bone = joints[joint] - joints[joint - 1];
+      const Eigen::Vector3d past = keypoints[k] - joints[joint];
+      // On the bone's line, 9-14 mm past the tip joint (measured: 9.6-12.6 mm on the asset).
+      EXPECT_LT(past.cross(bone.normalized()).norm(), 1e-12) << KeypointName(k);
+      EXPECT_GT(past.dot(bone.normalized()), 0.009) << KeypointName(k);
+      EXPECT_LT(past.norm(), 0.014) << KeypointName(k);
+      double farthest = -1.0;
+      for (int v : hand.VerticesMovedBy(joint - 1)) {
+        farthest = std::max(farthest, (hand.bind_vertices()[v].cast<double>() - keypoints[k]).dot(bone.normalized()));
+      }
+      EXPECT_NEAR(farthest, 0.0, 1e-9) << KeypointName(k);
+    }
+    Random random(testing::kTestSeed);
+    for (int trial = 0; trial < 20; ++trial) {
+      const HandPose pose = RandomPose(random, hand.handedness());
+      const Keypoints3d posed = hand.KeypointsOf(pose);
+      const JointPositions posed_joints = hand.JointPositionsOf(pose);
+      for (int k : {4, 8, 12, 16, 20}) {
+        const int joint = Index(KeypointJoint(k));
+        const Eigen::Vector3d bone = (posed_joints[joint] - posed_joints[joint - 1]).normalized();
+        const Eigen::Vector3d past = posed[k] - posed_joints[joint];
+        ASSERT_NEAR(past.norm(), (keypoints[k] - joints[joint]).norm(), 1e-12) << KeypointName(k);
+        ASSERT_LT(past.cross(bone).norm(), 1e-12) << KeypointName(k);
+      }
+    }
+  }
+}
+
 TEST(HandModelTest, KeypointsMoveWithTheirJointsOnly) {
   Random random(testing::kTestSeed);
   HandPose pose;

@@ -43,9 +43,14 @@ TEST(BvhTest, RestPoseIsTheModelsBindPoseInCentimetres) {
   const int tip = bvh.Find("middle-finger-phalanx-distal end");
   ASSERT_GE(tip, 0);
   const std::vector<Eigen::Vector3d> positions = bvh.Positions(0);
-  const Eigen::Vector3d expected =
-      kBvhUnitsPerMetre * testing::RightHand().bind_joint_positions()[Index(Joint::kMiddleTip)];
+  // The end site is the fingertip keypoint (keypoint 12), the finger's end.
+  const Eigen::Vector3d expected = kBvhUnitsPerMetre * testing::RightHand().bind_keypoints()[12];
   EXPECT_LT((positions[tip] - expected).norm(), 1e-4);
+  const int dip = bvh.Find("middle-finger-phalanx-distal");
+  ASSERT_GE(dip, 0);
+  const Eigen::Vector3d dip_joint =
+      kBvhUnitsPerMetre * testing::RightHand().bind_joint_positions()[Index(Joint::kMiddleDistal)];
+  EXPECT_LT((positions[dip] - dip_joint).norm(), 1e-4);
 }
 
 TEST(BvhTest, AnyChannelOrderIsRead) {

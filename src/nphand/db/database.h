@@ -68,6 +68,11 @@ struct Entry {
   cv::Mat crop;              // CV_8UC1, kCropBitsSide square, non-zero = hand
 };
 
+// The header's "keypoint_tips": the records' fingertip keypoints lie at the fingers' ends
+// (HandModel::bind_keypoints). Files without the field hold the asset's tip joints there,
+// 10-13 mm short of them.
+inline constexpr const char* kKeypointTips = "fingertip";
+
 // Checks a header against the format's schema; throws nphand::Error naming `source` and
 // the field ("x.db: header field 'render.fov_deg' must be a number in [5, 120]").
 void ValidateHeader(const nlohmann::json& header, const std::string& source);

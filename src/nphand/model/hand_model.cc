@@ -238,6 +238,7 @@ HandModel HandModel::FromGlb(std::span<const uint8_t> glb, Handedness handedness
       model.triangles_[t][k] = static_cast<int>(indices[3 * t + k]);
     }
   }
+  model.SetKeypoints();
   return model;
 }
 
@@ -275,7 +276,22 @@ HandModel HandModel::Reproportioned(double length, double width) const {
   // Normals transform by the inverse transpose of the scaling.
   for (Eigen::Vector3f& n : model.bind_normals_) n = n.cwiseQuotient(scale.cast<float>()).normalized();
   model.SetJointFrames();
+  model.SetKeypoints();
   return model;
+}
+
+void HandModel::SetKeypoints() {
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    const int joint = Index(KeypointJoint(k));
+    bind_keypoints_[k] = bind_positions_[joint];
+    if (!IsTip(joint)) continue;
+    const Eigen::Vector3d bone = (bind_positions_[joint] - bind_positions_[joint - 1]).normalized();
+    double reach = 0.0;
+    for (int v : VerticesMovedBy(joint - 1)) {
+      reach = std::max(reach, (bind_vertices_[v].cast<double>() - bind_positions_[joint]).dot(bone));
+    }
+    bind_keypoints_[k] += reach * bone;
+  }
 }
 
 Eigen::Vector3d HandModel::bind_centre() const {
@@ -338,9 +354,17 @@ JointPositions HandModel::JointPositionsOf(const HandPose& pose) const {
 }
 
 Keypoints3d HandModel::KeypointsOf(const HandPose& pose) const {
-  const JointPositions joints = JointPositionsOf(pose);
+  CheckHandedness(pose);
+  const auto transforms = JointTransforms(pose.angles);
   Keypoints3d keypoints;
-  for (int k = 0; k < kNumKeypoints; ++k) keypoints[k] = joints[Index(KeypointJoint(k))];
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    const int joint = Index(KeypointJoint(k));
+    // A fingertip moves with its tip joint, which moves with the last bone.
+    const Eigen::Vector3d in_hand =
+        IsTip(joint) ? Eigen::Vector3d(transforms[joint] * (joint_from_hand_[joint] * bind_keypoints_[k]))
+                     : transforms[joint].translation();
+    keypoints[k] = pose.camera_from_hand * in_hand;
+  }
   return keypoints;
 }
 

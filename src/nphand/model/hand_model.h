@@ -70,6 +70,11 @@ class HandModel {
   const Eigen::Isometry3d& hand_from_mesh() const { return hand_from_mesh_; }
   // Joint positions of the bind pose in the hand frame.
   const JointPositions& bind_joint_positions() const { return bind_positions_; }
+  // The 21 keypoints of the bind pose in the hand frame: the joints', but each fingertip at
+  // the end of its finger, where labelled hands and other trackers put it. The asset's tip
+  // joints lie within the last bones, 10-13 mm short of the skin's end (they move no skin);
+  // a fingertip is moved along its last bone to the farthest skin that bone moves.
+  const Keypoints3d& bind_keypoints() const { return bind_keypoints_; }
   // The mean of the bind-pose joint positions: a point near the middle of the hand, for
   // centring it in a view.
   Eigen::Vector3d bind_centre() const;
@@ -96,6 +101,8 @@ class HandModel {
   void CheckHandedness(const HandPose& pose) const;
   // The joints' anatomical frames and the bind transforms, from bind_positions_.
   void SetJointFrames();
+  // bind_keypoints_, from the joints and the mesh.
+  void SetKeypoints();
 
   Handedness handedness_ = Handedness::kRight;
   std::vector<Eigen::Vector3f> bind_vertices_;
@@ -105,6 +112,7 @@ class HandModel {
   std::vector<Eigen::Vector4f> skin_weights_;
   Eigen::Isometry3d hand_from_mesh_ = Eigen::Isometry3d::Identity();
   JointPositions bind_positions_;
+  Keypoints3d bind_keypoints_;
   std::array<Eigen::Matrix3d, kNumJoints> bind_axes_;
   // Bind pose: each joint's frame relative to its parent's, and the inverse of its own.
   std::array<Eigen::Isometry3d, kNumJoints> parent_from_joint_;

@@ -58,7 +58,12 @@ void WriteHierarchy(const HandModel& hand, double scale, int joint, int depth, s
                  : Eigen::Vector3d(kBvhUnitsPerMetre * scale *
                                    (hand.bind_joint_positions()[joint] - hand.bind_joint_positions()[parent]));
   if (IsTipJoint(joint)) {
-    out << indent << "End Site\n" << indent << "{\n" << indent << "  OFFSET " << Vector(offset) << "\n" << indent << "}\n";
+    // The end site is the fingertip keypoint: the finger's end, past the asset's tip joint.
+    int keypoint = 0;
+    while (Index(KeypointJoint(keypoint)) != joint) ++keypoint;
+    const Eigen::Vector3d tip =
+        kBvhUnitsPerMetre * scale * (hand.bind_keypoints()[keypoint] - hand.bind_joint_positions()[parent]);
+    out << indent << "End Site\n" << indent << "{\n" << indent << "  OFFSET " << Vector(tip) << "\n" << indent << "}\n";
     return;
   }
   out << indent << (parent < 0 ? "ROOT " : "JOINT ") << JointName(static_cast<Joint>(joint)) << "\n" << indent << "{\n";

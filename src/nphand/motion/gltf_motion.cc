@@ -135,6 +135,16 @@ std::vector<uint8_t> GltfMotionBytes(const HandModel& hand, std::span<const uint
   const double s = motion.scale;
   if (s != 1.0) gltf.nodes[root].scale = {s, s, s};
 
+  // The tip joints' nodes are put at the fingertip keypoints, the fingers' ends (they move
+  // no skin, so the mesh is as it was).
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    const int j = Index(KeypointJoint(k));
+    if (j != Index(Joint::kThumbTip) && (j < 9 || (j - 9) % 5 != 0)) continue;
+    NPHAND_THROW_CHECK(hand.VerticesMovedBy(j, 1e-6f).empty(), source, ": its joint '",
+                       JointName(static_cast<Joint>(j)), "' moves skin");
+    const Eigen::Vector3d tip = hand.hand_from_mesh().inverse() * hand.bind_keypoints()[k];
+    gltf.nodes[nodes[j]].translation = {tip.x(), tip.y(), tip.z()};
+  }
   std::array<Trs, kNumJoints> rest;
   std::array<Eigen::Isometry3d, kNumJoints> joint_from_hand;
   for (int j = 0; j < kNumJoints; ++j) {
