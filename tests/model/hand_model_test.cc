@@ -137,10 +137,11 @@ TEST(HandModelTest, FingertipKeypointsLieAtTheFingersEnds) {
       EXPECT_TRUE(hand.VerticesMovedBy(joint, 1e-6f).empty()) << KeypointName(k);
       const Eigen::Vector3d bone = joints[joint] - joints[joint - 1];
       const Eigen::Vector3d past = keypoints[k] - joints[joint];
-      // On the bone's line, 9-14 mm past the tip joint (measured: 9.6-12.6 mm on the asset).
+      // On the bone's line, 9-15 mm past the tip joint (measured: 9.6-12.6 mm on the asset,
+      // up to 13.9 on the hand 10 % longer).
       EXPECT_LT(past.cross(bone.normalized()).norm(), 1e-12) << KeypointName(k);
       EXPECT_GT(past.dot(bone.normalized()), 0.009) << KeypointName(k);
-      EXPECT_LT(past.norm(), 0.014) << KeypointName(k);
+      EXPECT_LT(past.norm(), 0.015) << KeypointName(k);
       double farthest = -1.0;
       for (int v : hand.VerticesMovedBy(joint - 1)) {
         farthest = std::max(farthest, (hand.bind_vertices()[v].cast<double>() - keypoints[k]).dot(bone.normalized()));
@@ -156,7 +157,7 @@ TEST(HandModelTest, FingertipKeypointsLieAtTheFingersEnds) {
         const int joint = Index(KeypointJoint(k));
         const Eigen::Vector3d bone = (posed_joints[joint] - posed_joints[joint - 1]).normalized();
         const Eigen::Vector3d past = posed[k] - posed_joints[joint];
-        ASSERT_NEAR(past.norm(), (keypoints[k] - joints[joint]).norm(), 1e-12) << KeypointName(k);
+        ASSERT_NEAR(past.dot(bone), (keypoints[k] - joints[joint]).norm(), 1e-12) << KeypointName(k);
         ASSERT_LT(past.cross(bone).norm(), 1e-12) << KeypointName(k);
       }
     }

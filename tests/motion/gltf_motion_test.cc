@@ -24,6 +24,15 @@ TEST(GltfMotionTest, TheAnimatedHandLoadsBackWithItsJointsFramesAndKeypoints) {
       // The project's own mesh reader takes it: the same rigged hand.
       const HandModel loaded = HandModel::FromGlb(bytes, hand->handedness(), path.string());
       EXPECT_EQ(loaded.bind_vertices().size(), hand->bind_vertices().size());
+      // Its tip joints stand at the fingertip keypoints, by its inverse bind matrices as by
+      // its nodes, and its keypoints are the model's.
+      for (int k : {4, 8, 12, 16, 20}) {
+        EXPECT_LT((loaded.bind_joint_positions()[Index(KeypointJoint(k))] - hand->bind_keypoints()[k]).norm(), 1e-6)
+            << KeypointName(k);
+      }
+      for (int k = 0; k < kNumKeypoints; ++k) {
+        EXPECT_LT((loaded.bind_keypoints()[k] - hand->bind_keypoints()[k]).norm(), 1e-6) << KeypointName(k);
+      }
 
       const GltfMotion read = ReadGltfMotion(bytes, path.string());
       EXPECT_EQ(read.joints, kNumJoints);
@@ -49,7 +58,8 @@ TEST(GltfMotionTest, TheSkinnedMeshFollowsTheJoints) {
   std::vector<Eigen::Vector3f> vertices;
   testing::RightHand().Skin(motion.frames[0].pose, &vertices, nullptr);
   const Keypoints3d keypoints = GltfKeypoints(read, 0);
-  // The closest skinned vertex to the index fingertip joint lies within a few millimetres.
+  // The closest skinned vertex to the index fingertip (keypoint 8, the finger's end) lies
+  // within a few millimetres.
   const Eigen::Vector3d tip = keypoints[8] - motion.frames[0].wrist_camera;
   double nearest = 1.0;
   for (const Eigen::Vector3f& v : vertices) nearest = std::min(nearest, (v.cast<double>() - tip).norm());

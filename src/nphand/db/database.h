@@ -70,7 +70,7 @@ struct Entry {
 
 // The header's "keypoint_tips": the records' fingertip keypoints lie at the fingers' ends
 // (HandModel::bind_keypoints). Files without the field hold the asset's tip joints there,
-// 10-13 mm short of them.
+// 9.6-12.6 mm short of them.
 inline constexpr const char* kKeypointTips = "fingertip";
 
 // Checks a header against the format's schema; throws nphand::Error naming `source` and

@@ -242,6 +242,7 @@ class HnswlibIndex : public KnnIndex {
       if (i + kAhead < rows.size()) {
         const uint8_t* ahead = node(i + kAhead);
         for (size_t line = 0; line < codes.size(); line += 64) __builtin_prefetch(ahead + line);
+        __builtin_prefetch(ahead + codes.size() - 1);  // the codes need not start on a cache line
       }
       out[i] = static_cast<float>(CodeDistance(codes.data(), node(i), codes.size())) * step_squared;
     }

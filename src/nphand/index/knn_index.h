@@ -98,7 +98,9 @@ class KnnIndex {
   IndexedSet set_;
   // By entry id, up to the largest the set holds: its row, or kNoRow. Distances looks up a
   // track's thousand-odd entries a frame; a binary search of the ids cost a quarter of a
-  // millisecond of it (their cache misses), this table (4 bytes an entry) a few microseconds.
+  // millisecond of it (their cache misses), this table a few microseconds. It takes 4 bytes
+  // per database entry up to the largest held (about 1 MB), shared by every backend and so
+  // not in MemoryBytes.
   static constexpr uint32_t kNoRow = UINT32_MAX;
   std::vector<uint32_t> row_of_;
 };

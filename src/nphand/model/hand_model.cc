@@ -32,7 +32,6 @@ Eigen::Matrix3d FrameFromBone(const Eigen::Vector3d& bone, const Eigen::Vector3d
   return axes;
 }
 
-bool IsTip(int joint) { return joint == 4 || (joint >= 9 && (joint - 9) % 5 == 0); }
 bool IsThumb(int joint) { return joint >= 1 && joint <= 4; }
 
 }  // namespace
@@ -250,7 +249,7 @@ void HandModel::SetJointFrames() {
       (bind_positions_[Index(Joint::kLittleProximal)] - bind_positions_[Index(Joint::kIndexProximal)]).normalized();
   bind_axes_[0] = Eigen::Matrix3d::Identity();
   for (int j = 1; j < kNumJoints; ++j) {
-    if (IsTip(j)) {
+    if (IsTipJoint(j)) {
       bind_axes_[j] = bind_axes_[j - 1];
       continue;
     }
@@ -284,7 +283,7 @@ void HandModel::SetKeypoints() {
   for (int k = 0; k < kNumKeypoints; ++k) {
     const int joint = Index(KeypointJoint(k));
     bind_keypoints_[k] = bind_positions_[joint];
-    if (!IsTip(joint)) continue;
+    if (!IsTipJoint(joint)) continue;
     const Eigen::Vector3d bone = (bind_positions_[joint] - bind_positions_[joint - 1]).normalized();
     double reach = 0.0;
     for (int v : VerticesMovedBy(joint - 1)) {
@@ -361,7 +360,7 @@ Keypoints3d HandModel::KeypointsOf(const HandPose& pose) const {
     const int joint = Index(KeypointJoint(k));
     // A fingertip moves with its tip joint, which moves with the last bone.
     const Eigen::Vector3d in_hand =
-        IsTip(joint) ? Eigen::Vector3d(transforms[joint] * (joint_from_hand_[joint] * bind_keypoints_[k]))
+        IsTipJoint(joint) ? Eigen::Vector3d(transforms[joint] * (joint_from_hand_[joint] * bind_keypoints_[k]))
                      : transforms[joint].translation();
     keypoints[k] = pose.camera_from_hand * in_hand;
   }

@@ -72,7 +72,7 @@ class HandModel {
   const JointPositions& bind_joint_positions() const { return bind_positions_; }
   // The 21 keypoints of the bind pose in the hand frame: the joints', but each fingertip at
   // the end of its finger, where labelled hands and other trackers put it. The asset's tip
-  // joints lie within the last bones, 10-13 mm short of the skin's end (they move no skin);
+  // joints lie within the last bones, 9.6-12.6 mm short of the skin's end (they move no skin);
   // a fingertip is moved along its last bone to the farthest skin that bone moves.
   const Keypoints3d& bind_keypoints() const { return bind_keypoints_; }
   // The mean of the bind-pose joint positions: a point near the middle of the hand, for

@@ -1,5 +1,7 @@
 #include "nphand/model/skeleton.h"
 
+#include <algorithm>
+
 #include "nphand/util/check.h"
 
 namespace nphand {
@@ -38,6 +40,8 @@ int JointParent(int joint) {
   return joint - 1;
 }
 
+bool IsTipJoint(int joint) { return joint == Index(Joint::kThumbTip) || (joint >= 9 && (joint - 9) % 5 == 0); }
+
 bool IsInSubtree(int joint, int ancestor) {
   for (int j = joint; j >= 0; j = JointParent(j)) {
     if (j == ancestor) return true;
@@ -48,6 +52,12 @@ bool IsInSubtree(int joint, int ancestor) {
 Joint KeypointJoint(int keypoint) {
   NPHAND_CHECK(keypoint >= 0 && keypoint < kNumKeypoints);
   return static_cast<Joint>(kKeypointJoints[keypoint]);
+}
+
+int JointKeypoint(int joint) {
+  NPHAND_CHECK(joint >= 0 && joint < kNumJoints);
+  const auto at = std::find(kKeypointJoints.begin(), kKeypointJoints.end(), joint);
+  return at == kKeypointJoints.end() ? -1 : static_cast<int>(at - kKeypointJoints.begin());
 }
 
 const char* KeypointName(int keypoint) {

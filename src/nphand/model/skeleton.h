@@ -24,14 +24,18 @@ inline constexpr int Index(Joint j) { return static_cast<int>(j); }
 const char* JointName(Joint joint);
 // The joint's parent in the kinematic tree; the wrist is the root and has none (returns -1).
 int JointParent(int joint);
+// True for the five tip joints (each finger's last, beyond its last bone's joint).
+bool IsTipJoint(int joint);
 // True when `joint` is `ancestor` or lies below it in the tree.
 bool IsInSubtree(int joint, int ancestor);
 
 // The 21 standard keypoints: wrist; thumb CMC, MCP, IP, tip; then for index, middle, ring
 // and little finger: MCP, PIP, DIP, tip.
 inline constexpr int kNumKeypoints = 21;
-// The joint whose position is keypoint k.
+// The joint whose position is keypoint k (for a fingertip, the tip joint it moves with).
 Joint KeypointJoint(int keypoint);
+// The keypoint of `joint` (-1 for the four finger metacarpals, which have none).
+int JointKeypoint(int joint);
 // A short name of keypoint k ("index_pip").
 const char* KeypointName(int keypoint);
 // The keypoint that keypoint k connects to towards the wrist (-1 for the wrist), for drawing.

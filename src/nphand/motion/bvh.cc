@@ -16,9 +16,6 @@
 namespace nphand {
 namespace {
 
-// The fingertips: the end sites.
-bool IsTipJoint(int joint) { return joint == Index(Joint::kThumbTip) || (joint >= 9 && (joint - 9) % 5 == 0); }
-
 std::vector<int> ChildrenOf(int joint) {
   std::vector<int> children;
   for (int j = 0; j < kNumJoints; ++j) {
@@ -53,19 +50,17 @@ Eigen::Vector3d ZxyDegrees(const Eigen::Matrix3d& r) {
 void WriteHierarchy(const HandModel& hand, double scale, int joint, int depth, std::ostringstream& out) {
   const std::string indent(2 * depth, ' ');
   const int parent = JointParent(joint);
+  if (IsTipJoint(joint)) {
+    // The end site is the fingertip keypoint: the finger's end, past the asset's tip joint.
+    const Eigen::Vector3d tip =
+        kBvhUnitsPerMetre * scale * (hand.bind_keypoints()[JointKeypoint(joint)] - hand.bind_joint_positions()[parent]);
+    out << indent << "End Site\n" << indent << "{\n" << indent << "  OFFSET " << Vector(tip) << "\n" << indent << "}\n";
+    return;
+  }
   const Eigen::Vector3d offset =
       parent < 0 ? Eigen::Vector3d::Zero()
                  : Eigen::Vector3d(kBvhUnitsPerMetre * scale *
                                    (hand.bind_joint_positions()[joint] - hand.bind_joint_positions()[parent]));
-  if (IsTipJoint(joint)) {
-    // The end site is the fingertip keypoint: the finger's end, past the asset's tip joint.
-    int keypoint = 0;
-    while (Index(KeypointJoint(keypoint)) != joint) ++keypoint;
-    const Eigen::Vector3d tip =
-        kBvhUnitsPerMetre * scale * (hand.bind_keypoints()[keypoint] - hand.bind_joint_positions()[parent]);
-    out << indent << "End Site\n" << indent << "{\n" << indent << "  OFFSET " << Vector(tip) << "\n" << indent << "}\n";
-    return;
-  }
   out << indent << (parent < 0 ? "ROOT " : "JOINT ") << JointName(static_cast<Joint>(joint)) << "\n" << indent << "{\n";
   out << indent << "  OFFSET " << Vector(offset) << "\n";
   out << indent << "  CHANNELS "

@@ -1,6 +1,8 @@
 #include "nphand/motion/gltf_motion.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <sstream>
 
@@ -135,15 +137,26 @@ std::vector<uint8_t> GltfMotionBytes(const HandModel& hand, std::span<const uint
   const double s = motion.scale;
   if (s != 1.0) gltf.nodes[root].scale = {s, s, s};
 
-  // The tip joints' nodes are put at the fingertip keypoints, the fingers' ends (they move
-  // no skin, so the mesh is as it was).
-  for (int k = 0; k < kNumKeypoints; ++k) {
-    const int j = Index(KeypointJoint(k));
-    if (j != Index(Joint::kThumbTip) && (j < 9 || (j - 9) % 5 != 0)) continue;
+  // The tip joints' nodes are put at the fingertip keypoints, the fingers' ends, their
+  // inverse bind matrices with them (the joints hang from an identity root, so a node's
+  // rest transform is its bind pose). They move no skin, so the mesh is as it was.
+  const tinygltf::Skin& skin = gltf.skins[0];
+  ReadAccessor<float>(gltf, skin.inverseBindMatrices, TINYGLTF_COMPONENT_TYPE_FLOAT, 16, source,
+                      "inverse bind matrices");  // checks that they lie within their buffer
+  const tinygltf::Accessor& binds = gltf.accessors[skin.inverseBindMatrices];
+  const tinygltf::BufferView& view = gltf.bufferViews[binds.bufferView];
+  for (size_t slot = 0; slot < skin.joints.size(); ++slot) {
+    const int j = static_cast<int>(std::find(nodes.begin(), nodes.end(), skin.joints[slot]) - nodes.begin());
+    if (!IsTipJoint(j)) continue;
     NPHAND_THROW_CHECK(hand.VerticesMovedBy(j, 1e-6f).empty(), source, ": its joint '",
                        JointName(static_cast<Joint>(j)), "' moves skin");
-    const Eigen::Vector3d tip = hand.hand_from_mesh().inverse() * hand.bind_keypoints()[k];
-    gltf.nodes[nodes[j]].translation = {tip.x(), tip.y(), tip.z()};
+    const Eigen::Vector3d tip = hand.hand_from_mesh().inverse() * hand.bind_keypoints()[JointKeypoint(j)];
+    tinygltf::Node& node = gltf.nodes[skin.joints[slot]];
+    node.translation = {tip.x(), tip.y(), tip.z()};
+    const Eigen::Matrix4f bind = NodeTrs(node, source).Matrix().inverse().matrix().cast<float>();  // column-major
+    const size_t stride = view.byteStride != 0 ? view.byteStride : sizeof(float) * 16;
+    std::memcpy(gltf.buffers[view.buffer].data.data() + view.byteOffset + binds.byteOffset + slot * stride,
+                bind.data(), sizeof(float) * 16);
   }
   std::array<Trs, kNumJoints> rest;
   std::array<Eigen::Isometry3d, kNumJoints> joint_from_hand;

@@ -128,8 +128,8 @@ std::vector<uint8_t> LabelsMeeting(const cv::Mat& labels, int count, const cv::M
 
 // Labels the 4-connected pieces of `mask` (CV_8UC1) into `labels` (CV_32SC1) and returns
 // their count (the background's label 0 included), with each label's pixels in `areas`:
-// cv::connectedComponentsWithStats's labels and areas, for its labelling's cost (its
-// statistics cost several times that).
+// the labels and areas of cv::connectedComponentsWithStats at the cost of the labelling
+// alone (its statistics cost about 5x that).
 int LabelPieces(const cv::Mat& mask, cv::Mat* labels, std::vector<int>* areas) {
   const int count = cv::connectedComponents(mask, *labels, 4, CV_32S);
   areas->assign(count, 0);
@@ -380,8 +380,9 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       cv::morphologyEx(out.skin, out.skin, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
     }
   };
-  // The fixed model's skin is classified first only where the cascade looks (it looks
-  // around that skin's regions) or where no face's chroma gates it (below).
+  // The fixed model's ungated skin is classified only where the cascade looks (it looks
+  // around that skin's regions) or where no face's chroma gates the skin (below); elsewhere
+  // the gated pass is the only one.
   bool classified = false;
 
   // Faces: looked for every face_interval frames, at once when a region that could hold
