@@ -361,7 +361,7 @@ Keypoints3d HandModel::KeypointsOf(const HandPose& pose) const {
     // A fingertip moves with its tip joint, which moves with the last bone.
     const Eigen::Vector3d in_hand =
         IsTipJoint(joint) ? Eigen::Vector3d(transforms[joint] * (joint_from_hand_[joint] * bind_keypoints_[k]))
-                     : transforms[joint].translation();
+                          : transforms[joint].translation();
     keypoints[k] = pose.camera_from_hand * in_hand;
   }
   return keypoints;
