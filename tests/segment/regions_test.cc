@@ -37,23 +37,25 @@ std::vector<cv::Mat> Masks() {
 
 TEST(RegionsTest, LabelsAndStatisticsAreOpenCVsOwn) {
   for (const cv::Mat& mask : Masks()) {
-    cv::Mat expected_labels, stats, centroids;
-    const int count = cv::connectedComponentsWithStats(mask, expected_labels, stats, centroids, 8, CV_32S);
-    cv::Mat labels;
-    const std::vector<RegionStats> found = LabelRegions(mask, &labels);
-    ASSERT_EQ(static_cast<int>(found.size()), count) << mask.size();
-    EXPECT_EQ(cv::countNonZero(labels != expected_labels), 0);
-    for (int l = 1; l < count; ++l) {
-      EXPECT_EQ(found[l].area, stats.at<int>(l, cv::CC_STAT_AREA));
-      EXPECT_EQ(found[l].box, cv::Rect(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
-                                       stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT)));
-      EXPECT_EQ(found[l].centroid.x, centroids.at<double>(l, 0));
-      EXPECT_EQ(found[l].centroid.y, centroids.at<double>(l, 1));
-      // The first pixel: in the box's top row, the region's own, and no earlier one of it.
-      const cv::Point first = found[l].first;
-      EXPECT_EQ(first.y, found[l].box.y);
-      EXPECT_EQ(labels.at<int>(first), l);
-      for (int x = 0; x < first.x; ++x) EXPECT_NE(labels.at<int>(first.y, x), l);
+    for (int connectivity : {8, 4}) {
+      cv::Mat expected_labels, stats, centroids;
+      const int count = cv::connectedComponentsWithStats(mask, expected_labels, stats, centroids, connectivity, CV_32S);
+      cv::Mat labels;
+      const std::vector<RegionStats> found = LabelRegions(mask, &labels, connectivity);
+      ASSERT_EQ(static_cast<int>(found.size()), count) << mask.size() << " connectivity " << connectivity;
+      EXPECT_EQ(cv::countNonZero(labels != expected_labels), 0);
+      for (int l = 1; l < count; ++l) {
+        EXPECT_EQ(found[l].area, stats.at<int>(l, cv::CC_STAT_AREA));
+        EXPECT_EQ(found[l].box, cv::Rect(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
+                                         stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT)));
+        EXPECT_EQ(found[l].centroid.x, centroids.at<double>(l, 0));
+        EXPECT_EQ(found[l].centroid.y, centroids.at<double>(l, 1));
+        // The first pixel: in the box's top row, the region's own, and no earlier one of it.
+        const cv::Point first = found[l].first;
+        EXPECT_EQ(first.y, found[l].box.y);
+        EXPECT_EQ(labels.at<int>(first), l);
+        for (int x = 0; x < first.x; ++x) EXPECT_NE(labels.at<int>(first.y, x), l);
+      }
     }
   }
 }
@@ -74,6 +76,7 @@ TEST(RegionsTest, BadMasksAreRefused) {
   cv::Mat labels;
   testing::ExpectError([&] { LabelRegions(cv::Mat(), &labels); }, "8-bit single-channel");
   testing::ExpectError([&] { LabelRegions(cv::Mat(4, 4, CV_32FC1), &labels); }, "8-bit single-channel");
+  testing::ExpectError([&] { LabelRegions(cv::Mat::zeros(4, 4, CV_8UC1), &labels, 6); }, "connectivity must be 4 or 8");
   testing::ExpectError([&] { Runs(cv::Mat(4, 4, CV_8UC3)); }, "8-bit single-channel");
 }
 

@@ -41,9 +41,10 @@ std::vector<MaskRun> Runs(const cv::Mat& mask) {
   return runs;
 }
 
-std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels) {
+std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels, int connectivity) {
+  NPHAND_THROW_CHECK(connectivity == 4 || connectivity == 8, "regions: connectivity must be 4 or 8, not ", connectivity);
   const std::vector<MaskRun> runs = Runs(mask);
-  const int count = cv::connectedComponents(mask, *labels, 8, CV_32S);
+  const int count = cv::connectedComponents(mask, *labels, connectivity, CV_32S);
   struct Sums {
     int64_t area = 0, x = 0, y = 0;
     int x0 = std::numeric_limits<int>::max(), x1 = -1, y1 = -1;

@@ -28,11 +28,12 @@ struct RegionStats {
   cv::Point first;       // its first pixel in raster order
 };
 
-// Labels the 8-connected regions of the non-zero pixels of `mask` (CV_8UC1) into `labels`
-// (CV_32SC1 of its size, 0 = background, regions 1..n in raster order of their first
-// pixel) and returns each label's statistics, indexed by label (index 0, the background,
-// is left empty). Throws nphand::Error for another type of mask.
-std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels);
+// Labels the 8-connected (or, with `connectivity` 4, 4-connected) regions of the non-zero
+// pixels of `mask` (CV_8UC1) into `labels` (CV_32SC1 of its size, 0 = background, regions
+// 1..n in raster order of their first pixel) and returns each label's statistics, indexed
+// by label (index 0, the background, is left empty). Throws nphand::Error for another type
+// of mask or connectivity.
+std::vector<RegionStats> LabelRegions(const cv::Mat& mask, cv::Mat* labels, int connectivity = 8);
 
 // How far from a region's box its hand's other pieces may lie (fingers an object or an
 // outline split off): the box grown by 0.3 of its longer side each way.

@@ -126,20 +126,6 @@ std::vector<uint8_t> LabelsMeeting(const cv::Mat& labels, int count, const cv::M
   return meets;
 }
 
-// Labels the 4-connected pieces of `mask` (CV_8UC1) into `labels` (CV_32SC1) and returns
-// their count (the background's label 0 included), with each label's pixels in `areas`:
-// the labels and areas of cv::connectedComponentsWithStats at the cost of the labelling
-// alone (its statistics cost about 5x that).
-int LabelPieces(const cv::Mat& mask, cv::Mat* labels, std::vector<int>* areas) {
-  const int count = cv::connectedComponents(mask, *labels, 4, CV_32S);
-  areas->assign(count, 0);
-  for (int y = 0; y < labels->rows; ++y) {
-    const int* label = labels->ptr<int>(y);
-    for (int x = 0; x < labels->cols; ++x) ++(*areas)[label[x]];
-  }
-  return count;
-}
-
 // The rim's pieces (`rim`, CV_8UC1, 255 = rim chroma; marked in passing) that meet `skin`
 // (8-connected) and cover at most `largest` pixels, added to `skin`. Only the pieces that
 // meet skin are visited, each once.
@@ -193,10 +179,9 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   const int k = std::max(3, widest / 12) | 1;
   cv::morphologyEx(pieces, pieces, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(k, k)));
   cv::Mat labels;
-  std::vector<int> areas;
-  // 4-connected, not LabelRegions' 8: pieces an outline parts that still touch at a corner
-  // stay apart.
-  const int count = LabelPieces(pieces, &labels, &areas);
+  // 4-connected, not 8: pieces an outline parts that still touch at a corner stay apart.
+  const std::vector<RegionStats> piece_stats = LabelRegions(pieces, &labels, 4);
+  const int count = static_cast<int>(piece_stats.size());
   if (count <= 1) return in_front;
   // Pixels by label of `of` (`n` labels) within each centre.
   auto in_centres = [&](const cv::Mat& of, int n) {
@@ -232,7 +217,7 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
     uint8_t* of_face = face_pieces.ptr<uint8_t>(y);
     for (int x = 0; x < labels.cols; ++x) {
       if (label[x] == 0) continue;
-      const bool small = areas[label[x]] < least && goes_on[label[x]] == 0;
+      const bool small = piece_stats[label[x]].area < least && goes_on[label[x]] == 0;
       (face[label[x]] != 0 || small ? of_face : keep)[x] = 255;
     }
   }
@@ -259,8 +244,8 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
   // (kInFrontWhole), unless it holds more of a face's centre than the face's piece does (a
   // face's own features shred it too, and its piece is then a part of it).
   cv::Mat rest_labels;
-  std::vector<int> rest_areas;
-  const int rests = LabelPieces(head_skin & ~face_zone, &rest_labels, &rest_areas);
+  const std::vector<RegionStats> rest_stats = LabelRegions(head_skin & ~face_zone, &rest_labels, 4);
+  const int rests = static_cast<int>(rest_stats.size());
   std::vector<uint8_t> arm = LabelsMeeting(rest_labels, rests, outside);
   arm[0] = 0;
   const std::vector<std::vector<int>> rest_centre = in_centres(rest_labels, rests);
@@ -274,7 +259,7 @@ cv::Mat InFrontOfFaces(const cv::Mat& work, const cv::Mat& skin, const cv::Mat& 
     const uint8_t* in = front.ptr<uint8_t>(y);
     for (int x = 0; x < labels.cols; ++x) covered[rest[x]] += in[x] != 0;
   }
-  for (int r = 1; r < rests; ++r) arm[r] &= covered[r] < kWholeShare * rest_areas[r] ? 1 : 0;
+  for (int r = 1; r < rests; ++r) arm[r] &= covered[r] < kWholeShare * rest_stats[r].area ? 1 : 0;
   for (int y = 0; y < labels.rows; ++y) {
     const int* rest = rest_labels.ptr<int>(y);
     uint8_t* in = front.ptr<uint8_t>(y);
