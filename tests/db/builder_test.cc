@@ -62,12 +62,12 @@ TEST(BuilderTest, GesturesFollowTheGraspsWithoutAnObject) {
   EXPECT_EQ(db.header()["gestures"], nlohmann::json::array({GestureByName("peace").id, GestureByName("fist").id}));
   EXPECT_EQ(db.header()["gesture_names"], nlohmann::json::array({"peace", "fist"}));
   // A build without gestures writes the header of the files before them, with the fingertips'
-  // keypoint_tips since: these fields, this order.
+  // keypoints since: these fields, this order.
   const nlohmann::json before = TinyDatabaseOptions().Header();
   std::vector<std::string> keys;
   for (const auto& [key, value] : before.items()) keys.push_back(key);
   EXPECT_EQ(keys, (std::vector<std::string>{"crop", "entries", "format", "grasp_objects", "grasps", "hand",
-                                            "hand_asset_sha256", "hog", "keypoint_tips", "order", "record_bytes",
+                                            "hand_asset_sha256", "hog", "keypoints", "order", "record_bytes",
                                             "render", "steps", "total_entries", "view_sphere", "view_sphere_coverage",
                                             "viewpoints"}));
   EXPECT_EQ(before["order"], "((grasp * steps + step) * 2 + with_object) * viewpoints + viewpoint");

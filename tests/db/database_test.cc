@@ -165,7 +165,7 @@ TEST(DatabaseTest, HeaderSchemaIsValidatedAtOpen) {
   refuse([](nlohmann::json& h) { h["entries"] = 3; }, "'shard'");
   refuse([](nlohmann::json& h) { h["shard"]["index"] = 10; }, "'shard.index'");
   refuse([](nlohmann::json& h) { h["hand"] = "left"; }, "'hand'");
-  refuse([](nlohmann::json& h) { h["keypoint_tips"] = "joint"; }, "'keypoint_tips' must be \"fingertip\"");
+  refuse([](nlohmann::json& h) { h["keypoints"] = "fingertip"; }, "'keypoints' must be \"fingertip ends, thumb base\"");
   refuse([](nlohmann::json& h) { h["gestures"] = {kFirstGestureId}; }, "lacks the field 'gesture_names'");
   refuse([](nlohmann::json& h) { h["gestures"] = {kNumGrasps}, h["gesture_names"] = {"fist"}; }, "'gestures[0]'");
   refuse([](nlohmann::json& h) { h["gestures"] = {kFirstGestureId}, h["gesture_names"] = {"peace"}; },

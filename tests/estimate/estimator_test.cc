@@ -174,8 +174,9 @@ TEST_F(EstimatorTest, AGestureIsNamedFromADatabaseWithGestures) {
 }
 
 // The model's hand length runs to the middle fingertip's keypoint, at the finger's end; a
-// database from before the fingertips moved there (no keypoint_tips in its header) holds
-// shorter ones, and the estimator refuses it by saying so rather than misjudge distances.
+// database from before the fingertips and the thumb's base moved (no keypoints in its
+// header; one from 2026-12-06 has keypoint_tips instead) holds other keypoints, and the
+// estimator refuses it by saying so rather than misjudge distances and places.
 TEST_F(EstimatorTest, TheHandLengthRunsToTheFingertipAndAnOlderDatabaseIsRefused) {
   EXPECT_NEAR(ModelHandLength(*db_), HandLength(RightHand().bind_keypoints()), 1e-6);
   const JointPositions& j = RightHand().bind_joint_positions();
@@ -185,14 +186,17 @@ TEST_F(EstimatorTest, TheHandLengthRunsToTheFingertipAndAnOlderDatabaseIsRefused
                               (j[Index(Joint::kMiddleTip)] - j[Index(Joint::kMiddleDistal)]).norm();
   EXPECT_NEAR(ModelHandLength(*db_) - along_joints,
               (RightHand().bind_keypoints()[12] - j[Index(Joint::kMiddleTip)]).norm(), 1e-6);
-  nlohmann::json header = testing::HeaderOf(ReadFileBytes(Path()));
-  header.erase("keypoint_tips");
-  const std::filesystem::path older = testing::ScratchDir() / "older.db";
-  WriteFileAtomic(older, testing::WithHeader(ReadFileBytes(Path()), header));
-  const Database db = Database::Open(older);
-  testing::ExpectError([&] { ModelHandLength(db); }, "make it again with `nphand db build`");
-  testing::ExpectError([&] { Estimator(db, *index_, RightHand(), Options()); },
-                       "fingertip keypoints are the hand asset's tip joints");
+  for (const bool tips_moved : {false, true}) {
+    nlohmann::json header = testing::HeaderOf(ReadFileBytes(Path()));
+    header.erase("keypoints");
+    if (tips_moved) header["keypoint_tips"] = "fingertip";
+    const std::filesystem::path older = testing::ScratchDir() / "older.db";
+    WriteFileAtomic(older, testing::WithHeader(ReadFileBytes(Path()), header));
+    const Database db = Database::Open(older);
+    testing::ExpectError([&] { ModelHandLength(db); }, "make it again with `nphand db build`");
+    testing::ExpectError([&] { Estimator(db, *index_, RightHand(), Options()); },
+                         "the database's keypoints are the hand asset's joints");
+  }
 }
 
 TEST_F(EstimatorTest, KeypointsAndDistanceArePlacedInTheFrame) {

@@ -24,7 +24,8 @@ TEST(BvhTest, ReadBackAndRunThroughForwardKinematicsItGivesTheKeypoints) {
     const Bvh bvh = ReadBvh(path);
     ASSERT_EQ(bvh.frames.size(), 40u);
     EXPECT_NEAR(bvh.frame_time_s, 1.0 / 30.0, 1e-6);
-    EXPECT_EQ(bvh.joints.size(), static_cast<size_t>(kNumJoints));  // 20 with channels, 5 end sites
+    // 20 with channels, 5 end sites, and the thumb's base without channels and its end site.
+    EXPECT_EQ(bvh.joints.size(), static_cast<size_t>(kNumJoints) + 2);
     EXPECT_EQ(bvh.channels, 6 + 19 * 3);
     double worst = 0.0;
     for (size_t f = 0; f < motion.frames.size(); ++f) {
@@ -51,6 +52,15 @@ TEST(BvhTest, RestPoseIsTheModelsBindPoseInCentimetres) {
   const Eigen::Vector3d dip_joint =
       kBvhUnitsPerMetre * testing::RightHand().bind_joint_positions()[Index(Joint::kMiddleDistal)];
   EXPECT_LT((positions[dip] - dip_joint).norm(), 1e-4);
+  // The thumb's base is keypoint 1, behind the thumb's pivot; its end site is the pivot.
+  const int base = bvh.Find(kBvhThumbBase);
+  ASSERT_GE(base, 0);
+  EXPECT_EQ(bvh.joints[base].parent, bvh.Find("wrist"));
+  EXPECT_TRUE(bvh.joints[base].channels.empty());
+  EXPECT_LT((positions[base] - kBvhUnitsPerMetre * testing::RightHand().bind_keypoints()[1]).norm(), 1e-4);
+  const Eigen::Vector3d pivot =
+      kBvhUnitsPerMetre * testing::RightHand().bind_joint_positions()[Index(Joint::kThumbMetacarpal)];
+  EXPECT_LT((positions[bvh.Find(std::string(kBvhThumbBase) + " end")] - pivot).norm(), 1e-4);
 }
 
 TEST(BvhTest, AnyChannelOrderIsRead) {

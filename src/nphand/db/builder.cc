@@ -165,7 +165,7 @@ nlohmann::json DatabaseBuildOptions::Header() const {
       {"view_sphere_coverage", CoverageJson(directions)},
       {"hand", "right"},
       {"hand_asset_sha256", PinnedAssetSha256(Handedness::kRight)},
-      {"keypoint_tips", kKeypointTips},
+      {"keypoints", kKeypointRule},
       {"render", {{"image_size", image_size}, {"fov_deg", fov_deg}, {"distance_m", distance}}},
       {"crop", {{"size", descriptor.crop_size}, {"margin", descriptor.crop_margin}}},
   };

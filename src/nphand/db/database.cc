@@ -184,9 +184,9 @@ void ValidateHeader(const nlohmann::json& header, const std::string& source) {
     f.Number(coverage, "covering_radius_deg", "view_sphere_coverage.covering_radius_deg", 0.0, 180.0);
   }
   f.String(header, "hand_asset_sha256", "hand_asset_sha256");
-  if (header.contains("keypoint_tips")) {  // optional: older files lack it
-    f.Expect(f.String(header, "keypoint_tips", "keypoint_tips") == kKeypointTips, "keypoint_tips",
-             std::string("must be \"") + kKeypointTips + "\"");
+  if (header.contains("keypoints")) {  // optional: older files lack it
+    f.Expect(f.String(header, "keypoints", "keypoints") == kKeypointRule, "keypoints",
+             std::string("must be \"") + kKeypointRule + "\"");
   }
 
   const nlohmann::json& grasps = f.Array(header, "grasps", "grasps");

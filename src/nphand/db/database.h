@@ -68,10 +68,12 @@ struct Entry {
   cv::Mat crop;              // CV_8UC1, kCropBitsSide square, non-zero = hand
 };
 
-// The header's "keypoint_tips": the records' fingertip keypoints lie at the fingers' ends
-// (HandModel::bind_keypoints). Files without the field hold the asset's tip joints there,
-// 9.6-12.6 mm short of them.
-inline constexpr const char* kKeypointTips = "fingertip";
+// The header's "keypoints": the records' fingertip keypoints lie at the fingers' ends and the
+// thumb's CMC at the thumb's base (HandModel::bind_keypoints). Files without the field hold
+// the asset's joints there: files from before 2026-12-06 its tip joints, 9.6-12.6 mm short of
+// the fingers' ends, and files from 2026-12-06 (their header's "keypoint_tips") its thumb
+// pivot, 8 mm out along the metacarpal.
+inline constexpr const char* kKeypointRule = "fingertip ends, thumb base";
 
 // Checks a header against the format's schema; throws nphand::Error naming `source` and
 // the field ("x.db: header field 'render.fov_deg' must be a number in [5, 120]").

@@ -243,9 +243,10 @@ void SetHandChoice(const std::string& text, EstimatorOptions* options) {
 }
 
 double ModelHandLength(const Database& db) {
-  NPHAND_THROW_CHECK(db.header().value("keypoint_tips", "") == kKeypointTips,
-                     "the database's fingertip keypoints are the hand asset's tip joints, 9.6-12.6 mm short of the "
-                     "fingers' ends (a file made before 2026-12-06): make it again with `nphand db build`");
+  NPHAND_THROW_CHECK(db.header().value("keypoints", "") == kKeypointRule,
+                     "the database's keypoints are the hand asset's joints where labelled hands put them elsewhere "
+                     "(its tip joints short of the fingers' ends, or its thumb pivot past the thumb's base: a file "
+                     "made before 2026-12-07): make it again with `nphand db build`");
   for (size_t i = 0; i < db.size(); ++i) {
     if (db.Meta(i).has_hand) return HandLength(db.Keypoints(i));
   }

@@ -238,8 +238,8 @@ std::vector<double> CombineWithPrior(const std::vector<PoseX>& poses, const std:
 double CandidateScore(const SkinRegion& region, cv::Size frame, cv::Rect last_box, int last_area);
 
 // The length of the database's hand from the wrist to the middle fingertip along its
-// bones (metres); throws nphand::Error for a database without a hand, or whose fingertip
-// keypoints are not at the fingers' ends (the header's keypoint_tips).
+// bones (metres); throws nphand::Error for a database without a hand, or whose keypoints
+// are older ones (the header's keypoints: HandModel::bind_keypoints).
 double ModelHandLength(const Database& db);
 
 class Estimator {

@@ -283,13 +283,17 @@ void HandModel::SetKeypoints() {
   for (int k = 0; k < kNumKeypoints; ++k) {
     const int joint = Index(KeypointJoint(k));
     bind_keypoints_[k] = bind_positions_[joint];
-    if (!IsTipJoint(joint)) continue;
-    const Eigen::Vector3d bone = (bind_positions_[joint] - bind_positions_[joint - 1]).normalized();
+    if (!IsTipJoint(joint) && joint != Index(Joint::kThumbMetacarpal)) continue;
+    // A fingertip goes forward along its last bone to the farthest skin that bone moves; the
+    // thumb's base goes back along its metacarpal to the nearest skin the thumb moves.
+    const int bone_joint = IsTipJoint(joint) ? joint - 1 : joint;
+    const Eigen::Vector3d bone = (bind_positions_[bone_joint + 1] - bind_positions_[bone_joint]).normalized();
+    const double way = IsTipJoint(joint) ? 1.0 : -1.0;
     double reach = 0.0;
-    for (int v : VerticesMovedBy(joint - 1)) {
-      reach = std::max(reach, (bind_vertices_[v].cast<double>() - bind_positions_[joint]).dot(bone));
+    for (int v : VerticesMovedBy(bone_joint)) {
+      reach = std::max(reach, way * (bind_vertices_[v].cast<double>() - bind_positions_[joint]).dot(bone));
     }
-    bind_keypoints_[k] += reach * bone;
+    bind_keypoints_[k] += way * reach * bone;
   }
 }
 
@@ -358,10 +362,12 @@ Keypoints3d HandModel::KeypointsOf(const HandPose& pose) const {
   Keypoints3d keypoints;
   for (int k = 0; k < kNumKeypoints; ++k) {
     const int joint = Index(KeypointJoint(k));
-    // A fingertip moves with its tip joint, which moves with the last bone.
+    // A fingertip moves with its tip joint, which moves with the last bone; the thumb's base
+    // lies on the wrist's side of the thumb's pivot and moves with the wrist.
+    const int frame = joint == Index(Joint::kThumbMetacarpal) ? JointParent(joint) : joint;
     const Eigen::Vector3d in_hand =
-        IsTipJoint(joint) ? Eigen::Vector3d(transforms[joint] * (joint_from_hand_[joint] * bind_keypoints_[k]))
-                          : transforms[joint].translation();
+        frame != joint || IsTipJoint(joint) ? Eigen::Vector3d(transforms[frame] * (joint_from_hand_[frame] * bind_keypoints_[k]))
+                                            : transforms[joint].translation();
     keypoints[k] = pose.camera_from_hand * in_hand;
   }
   return keypoints;

@@ -70,10 +70,15 @@ class HandModel {
   const Eigen::Isometry3d& hand_from_mesh() const { return hand_from_mesh_; }
   // Joint positions of the bind pose in the hand frame.
   const JointPositions& bind_joint_positions() const { return bind_positions_; }
-  // The 21 keypoints of the bind pose in the hand frame: the joints', but each fingertip at
-  // the end of its finger, where labelled hands and other trackers put it. The asset's tip
-  // joints lie within the last bones, 9.6-12.6 mm short of the skin's end (they move no skin);
-  // a fingertip is moved along its last bone to the farthest skin that bone moves.
+  // The 21 keypoints of the bind pose in the hand frame: the joints', but where labelled
+  // hands and other trackers put a keypoint elsewhere than the asset's joint:
+  // - each fingertip at the end of its finger. The asset's tip joints lie within the last
+  //   bones, 9.6-12.6 mm short of the skin's end (they move no skin); a fingertip is moved
+  //   along its last bone to the farthest skin that bone moves.
+  // - the thumb's CMC at the thumb's base. The asset's thumb pivot lies 8 mm out along the
+  //   metacarpal from it (wrist to CMC 50 mm, CMC to MCP 33; InterHand2.6M's labels 38 and
+  //   37); the keypoint is moved back along the metacarpal to the nearest skin the thumb
+  //   moves, and it moves with the wrist, not with the thumb.
   const Keypoints3d& bind_keypoints() const { return bind_keypoints_; }
   // The mean of the bind-pose joint positions: a point near the middle of the hand, for
   // centring it in a view.

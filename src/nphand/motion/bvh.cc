@@ -66,6 +66,20 @@ void WriteHierarchy(const HandModel& hand, double scale, int joint, int depth, s
   out << indent << "  CHANNELS "
       << (parent < 0 ? "6 Xposition Yposition Zposition Zrotation Xrotation Yrotation" : "3 Zrotation Xrotation Yrotation")
       << "\n";
+  if (parent < 0) {
+    // The thumb's base (its CMC keypoint) is fixed to the wrist: a joint without channels,
+    // whose end site is the thumb's pivot.
+    const int pivot = Index(Joint::kThumbMetacarpal);
+    const Eigen::Vector3d base = hand.bind_keypoints()[JointKeypoint(pivot)];
+    const std::string inner = indent + "  ";
+    out << inner << "JOINT " << kBvhThumbBase << "\n" << inner << "{\n";
+    out << inner << "  OFFSET " << Vector(kBvhUnitsPerMetre * scale * (base - hand.bind_joint_positions()[joint])) << "\n";
+    out << inner << "  CHANNELS 0\n";
+    out << inner << "  End Site\n" << inner << "  {\n" << inner << "    OFFSET "
+        << Vector(kBvhUnitsPerMetre * scale * (hand.bind_joint_positions()[pivot] - base)) << "\n"
+        << inner << "  }\n";
+    out << inner << "}\n";
+  }
   for (int child : ChildrenOf(joint)) WriteHierarchy(hand, scale, child, depth + 1, out);
   out << indent << "}\n";
 }
@@ -284,8 +298,9 @@ Keypoints3d BvhKeypoints(const Bvh& bvh, size_t frame) {
   Keypoints3d keypoints;
   for (int k = 0; k < kNumKeypoints; ++k) {
     const int joint = Index(KeypointJoint(k));
-    const std::string name = IsTipJoint(joint) ? std::string(JointName(static_cast<Joint>(joint - 1))) + " end"
-                                               : JointName(static_cast<Joint>(joint));
+    const std::string name = IsTipJoint(joint)                       ? std::string(JointName(static_cast<Joint>(joint - 1))) + " end"
+                             : joint == Index(Joint::kThumbMetacarpal) ? std::string(kBvhThumbBase)
+                                                                       : JointName(static_cast<Joint>(joint));
     const int j = bvh.Find(name);
     NPHAND_THROW_CHECK(j >= 0, "BVH: no joint '", name, "' (not a generic-hand skeleton)");
     keypoints[k] = camera_from_world * positions[j] / kBvhUnitsPerMetre;

@@ -3,7 +3,9 @@
 // nphand's BVH: the root is the wrist (6 channels: Xposition Yposition Zposition Zrotation
 // Xrotation Yrotation), every other joint of the generic hand has 3 rotation channels
 // (Zrotation Xrotation Yrotation), the five fingertips are End Sites; 20 joints with
-// channels and 5 end sites. Units are centimetres, the world frame is WorldFromCamera()'s.
+// channels and 5 end sites. A joint "thumb-base" without channels, a child of the wrist,
+// stands at the thumb's CMC keypoint (the thumb's base, behind the asset's thumb pivot:
+// HandModel::bind_keypoints), its end site at the pivot. Units are centimetres, the world frame is WorldFromCamera()'s.
 // In the rest pose (all channels zero) the skeleton is the model's bind pose, an open flat
 // hand with its back towards +z, fingers towards +x and (right hand) thumb towards +y,
 // scaled by the motion's scale; the root's rotation is the wrist's orientation.
@@ -22,6 +24,8 @@
 namespace nphand {
 
 inline constexpr double kBvhUnitsPerMetre = 100.0;
+// The name of the joint at the thumb's CMC keypoint.
+inline constexpr const char* kBvhThumbBase = "thumb-base";
 
 // Writes `motion` of `hand` (the model of the motion's side) as BVH, atomically.
 void WriteBvh(const HandModel& hand, const Motion& motion, const std::filesystem::path& path);

@@ -167,6 +167,15 @@ std::vector<uint8_t> GltfMotionBytes(const HandModel& hand, std::span<const uint
     hand_from_joint.translation() = hand.bind_joint_positions()[j];
     joint_from_hand[j] = hand_from_joint.inverse();
   }
+  // The thumb's base (its CMC keypoint, behind the thumb's pivot) is a node of its own,
+  // fixed to the wrist's node: the wrist moves it as it moves the skin.
+  tinygltf::Node thumb_base;
+  thumb_base.name = kGltfThumbBaseNode;
+  const Eigen::Vector3d base =
+      rest[0].Matrix().inverse() * (hand.hand_from_mesh().inverse() * hand.bind_keypoints()[JointKeypoint(Index(Joint::kThumbMetacarpal))]);
+  thumb_base.translation = {base.x(), base.y(), base.z()};
+  gltf.nodes[nodes[0]].children.push_back(static_cast<int>(gltf.nodes.size()));
+  gltf.nodes.push_back(thumb_base);
   const size_t count = motion.frames.size();
   std::vector<float> times(count);
   std::array<std::vector<float>, kNumJoints> translations, rotations;
@@ -226,6 +235,9 @@ GltfMotion ReadGltfMotion(std::span<const uint8_t> glb, const std::string& sourc
   const std::vector<int> parents = NodeParents(gltf, source);
   NPHAND_THROW_CHECK(!gltf.animations.empty(), source, ": no animation");
   const tinygltf::Animation& animation = gltf.animations[0];
+  const auto named = std::find_if(gltf.nodes.begin(), gltf.nodes.end(),
+                                  [](const tinygltf::Node& node) { return node.name == kGltfThumbBaseNode; });
+  const int thumb_base = named == gltf.nodes.end() ? -1 : static_cast<int>(named - gltf.nodes.begin());
 
   // Each animated node's keys, by path.
   size_t keys = 0;
@@ -278,17 +290,19 @@ GltfMotion ReadGltfMotion(std::span<const uint8_t> glb, const std::string& sourc
       }
       local[n] = trs.Matrix();
     }
-    JointPositions positions;
-    for (int j = 0; j < kNumJoints; ++j) {
-      Eigen::Affine3d global = local[nodes[j]];
+    auto position = [&](int node) {
+      Eigen::Affine3d global = local[node];
       size_t depth = 0;
-      for (int p = parents[nodes[j]]; p >= 0; p = parents[p]) {
+      for (int p = parents[node]; p >= 0; p = parents[p]) {
         NPHAND_THROW_CHECK(++depth <= gltf.nodes.size(), source, ": the node tree has a cycle");
         global = local[p] * global;
       }
-      positions[j] = global.translation();
-    }
+      return Eigen::Vector3d(global.translation());
+    };
+    JointPositions positions;
+    for (int j = 0; j < kNumJoints; ++j) positions[j] = position(nodes[j]);
     motion.frames.push_back(positions);
+    if (thumb_base >= 0) motion.thumb_bases.push_back(position(thumb_base));
   }
   return motion;
 }
@@ -296,9 +310,12 @@ GltfMotion ReadGltfMotion(std::span<const uint8_t> glb, const std::string& sourc
 Keypoints3d GltfKeypoints(const GltfMotion& motion, size_t frame) {
   NPHAND_CHECK(frame < motion.frames.size());
   const Eigen::Matrix3d camera_from_world = WorldFromCamera().transpose();
+  NPHAND_THROW_CHECK(motion.thumb_bases.size() == motion.frames.size(), "glTF: no node '", kGltfThumbBaseNode,
+                     "' (the thumb's CMC keypoint; not an nphand file, or one written before 2026-12-07)");
   Keypoints3d keypoints;
   for (int k = 0; k < kNumKeypoints; ++k) {
-    keypoints[k] = camera_from_world * motion.frames[frame][Index(KeypointJoint(k))];
+    const int joint = Index(KeypointJoint(k));
+    keypoints[k] = camera_from_world * (joint == Index(Joint::kThumbMetacarpal) ? motion.thumb_bases[frame] : motion.frames[frame][joint]);
   }
   return keypoints;
 }
