@@ -1,5 +1,7 @@
 #include "nphand/motion/gltf_motion.h"
 
+#include <algorithm>
+
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
@@ -47,6 +49,21 @@ TEST(GltfMotionTest, TheAnimatedHandLoadsBackWithItsJointsFramesAndKeypoints) {
       EXPECT_LT(worst, 1e-4) << ToString(hand->handedness()) << " scale " << scale << ": metres";
     }
   }
+}
+
+// A file without the thumb's base (another tool's, or nphand's before 2026-12-07) is read,
+// but its keypoints are refused rather than given with the thumb's pivot for its CMC.
+TEST(GltfMotionTest, KeypointsNeedTheThumbsBase) {
+  const Motion motion = testing::RandomMotion(Handedness::kRight, 2, 25.0, 1.0, 5);
+  std::vector<uint8_t> bytes = GltfMotionBytes(testing::RightHand(), AssetBytes(Handedness::kRight), motion);
+  const std::string name = kGltfThumbBaseNode;
+  const auto at = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
+  ASSERT_NE(at, bytes.end());
+  *(at + 6) = 'o';  // "thumb-bose": the same length, so the file stays whole
+  const GltfMotion read = ReadGltfMotion(bytes, "renamed.glb");
+  EXPECT_EQ(read.frames.size(), 2u);
+  EXPECT_TRUE(read.thumb_bases.empty());
+  testing::ExpectError([&] { GltfKeypoints(read, 0); }, "no node 'thumb-base'");
 }
 
 TEST(GltfMotionTest, TheSkinnedMeshFollowsTheJoints) {

@@ -5,7 +5,8 @@
 // (Zrotation Xrotation Yrotation), the five fingertips are End Sites; 20 joints with
 // channels and 5 end sites. A joint "thumb-base" without channels, a child of the wrist,
 // stands at the thumb's CMC keypoint (the thumb's base, behind the asset's thumb pivot:
-// HandModel::bind_keypoints), its end site at the pivot. Units are centimetres, the world frame is WorldFromCamera()'s.
+// HandModel::bind_keypoints), its end site at the pivot. Units are centimetres, the world
+// frame is WorldFromCamera()'s.
 // In the rest pose (all channels zero) the skeleton is the model's bind pose, an open flat
 // hand with its back towards +z, fingers towards +x and (right hand) thumb towards +y,
 // scaled by the motion's scale; the root's rotation is the wrist's orientation.

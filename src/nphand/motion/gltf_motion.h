@@ -3,8 +3,9 @@
 // one animation, "nphand": per frame, every joint node's translation and rotation (linear
 // keys at frame / fps seconds). The tip joints' nodes stand at the fingertip keypoints, and
 // a node "thumb-base", a child of the wrist's, at the thumb's CMC keypoint (the thumb's base,
-// behind the asset's thumb pivot: HandModel::bind_keypoints). The world frame is WorldFromCamera()'s, in metres; the
-// skeleton's root node is scaled by the motion's scale. Any glTF viewer plays it.
+// behind the asset's thumb pivot: HandModel::bind_keypoints). The world frame is
+// WorldFromCamera()'s, in metres; the skeleton's root node is scaled by the motion's scale.
+// Any glTF viewer plays it.
 #pragma once
 
 #include <cstdint>
