@@ -24,9 +24,9 @@ TEST(BvhTest, ReadBackAndRunThroughForwardKinematicsItGivesTheKeypoints) {
     const Bvh bvh = ReadBvh(path);
     ASSERT_EQ(bvh.frames.size(), 40u);
     EXPECT_NEAR(bvh.frame_time_s, 1.0 / 30.0, 1e-6);
-    // 20 with channels, 5 end sites, and the thumb's base without channels and its end site.
+    // 20 with channels, 5 end sites, and the thumb's base and its end site.
     EXPECT_EQ(bvh.joints.size(), static_cast<size_t>(kNumJoints) + 2);
-    EXPECT_EQ(bvh.channels, 6 + 19 * 3);
+    EXPECT_EQ(bvh.channels, 6 + 20 * 3);
     double worst = 0.0;
     for (size_t f = 0; f < motion.frames.size(); ++f) {
       worst = std::max(worst, MaxKeypointDifference(BvhKeypoints(bvh, f), MotionKeypoints(*hand, motion, f)));
@@ -56,11 +56,30 @@ TEST(BvhTest, RestPoseIsTheModelsBindPoseInCentimetres) {
   const int base = bvh.Find(kBvhThumbBase);
   ASSERT_GE(base, 0);
   EXPECT_EQ(bvh.joints[base].parent, bvh.Find("wrist"));
-  EXPECT_TRUE(bvh.joints[base].channels.empty());
+  EXPECT_EQ(bvh.joints[base].channels, (std::vector<std::string>{"Zrotation", "Xrotation", "Yrotation"}));
   EXPECT_LT((positions[base] - kBvhUnitsPerMetre * testing::RightHand().bind_keypoints()[1]).norm(), 1e-4);
   const Eigen::Vector3d pivot =
       kBvhUnitsPerMetre * testing::RightHand().bind_joint_positions()[Index(Joint::kThumbMetacarpal)];
   EXPECT_LT((positions[bvh.Find(std::string(kBvhThumbBase) + " end")] - pivot).norm(), 1e-4);
+}
+
+// The thumb's base turns with the wrist only: its channels are zero in every frame. A file
+// without it (another tool's, or nphand's before 2026-12-07) is read, but its keypoints are
+// refused rather than given with the thumb's pivot for its CMC.
+TEST(BvhTest, TheThumbsBaseStaysStillAndKeypointsNeedIt) {
+  const Motion motion = testing::RandomMotion(Handedness::kRight, 3, 30.0, 1.0, 9);
+  const std::string text = BvhText(testing::RightHand(), motion);
+  const Bvh bvh = ParseBvh(text, "hand.bvh");
+  const int base = bvh.Find(kBvhThumbBase);
+  ASSERT_GE(base, 0);
+  for (const std::vector<double>& values : bvh.frames) {
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(values[bvh.joints[base].first_channel + c], 0.0);
+  }
+  std::string renamed = text;
+  renamed.replace(renamed.find(kBvhThumbBase), std::string(kBvhThumbBase).size(), "thumb-bose");
+  const Bvh older = ParseBvh(renamed, "older.bvh");
+  ASSERT_EQ(older.frames.size(), 3u);
+  testing::ExpectError([&] { BvhKeypoints(older, 0); }, "no joint 'thumb-base' (the thumb's CMC keypoint");
 }
 
 TEST(BvhTest, AnyChannelOrderIsRead) {

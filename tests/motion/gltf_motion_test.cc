@@ -59,7 +59,7 @@ TEST(GltfMotionTest, KeypointsNeedTheThumbsBase) {
   const std::string name = kGltfThumbBaseNode;
   const auto at = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
   ASSERT_NE(at, bytes.end());
-  *(at + 6) = 'o';  // "thumb-bose": the same length, so the file stays whole
+  *(at + 7) = 'o';  // "thumb-bose": the same length, so the file stays whole
   const GltfMotion read = ReadGltfMotion(bytes, "renamed.glb");
   EXPECT_EQ(read.frames.size(), 2u);
   EXPECT_TRUE(read.thumb_bases.empty());

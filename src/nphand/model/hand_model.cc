@@ -283,7 +283,7 @@ void HandModel::SetKeypoints() {
   for (int k = 0; k < kNumKeypoints; ++k) {
     const int joint = Index(KeypointJoint(k));
     bind_keypoints_[k] = bind_positions_[joint];
-    if (!IsTipJoint(joint) && joint != Index(Joint::kThumbMetacarpal)) continue;
+    if (!IsTipJoint(joint) && k != kThumbBaseKeypoint) continue;
     // A fingertip goes forward along its last bone to the farthest skin that bone moves; the
     // thumb's base goes back along its metacarpal to the nearest skin the thumb moves.
     const int bone_joint = IsTipJoint(joint) ? joint - 1 : joint;
@@ -364,7 +364,7 @@ Keypoints3d HandModel::KeypointsOf(const HandPose& pose) const {
     const int joint = Index(KeypointJoint(k));
     // A fingertip moves with its tip joint, which moves with the last bone; the thumb's base
     // lies on the wrist's side of the thumb's pivot and moves with the wrist.
-    const int frame = joint == Index(Joint::kThumbMetacarpal) ? JointParent(joint) : joint;
+    const int frame = k == kThumbBaseKeypoint ? Index(Joint::kWrist) : joint;
     const Eigen::Vector3d in_hand =
         frame != joint || IsTipJoint(joint) ? Eigen::Vector3d(transforms[frame] * (joint_from_hand_[frame] * bind_keypoints_[k]))
                                             : transforms[joint].translation();

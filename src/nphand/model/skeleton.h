@@ -32,8 +32,13 @@ bool IsInSubtree(int joint, int ancestor);
 // The 21 standard keypoints: wrist; thumb CMC, MCP, IP, tip; then for index, middle, ring
 // and little finger: MCP, PIP, DIP, tip.
 inline constexpr int kNumKeypoints = 21;
-// The joint whose position is keypoint k (for a fingertip, the tip joint it moves with).
+// The joint whose position is keypoint k, or that it stands for: a fingertip is the finger's
+// end, past its tip joint and moving with it; the thumb's CMC (kThumbBaseKeypoint) is the
+// thumb's base, behind the thumb-metacarpal joint and moving with the wrist
+// (HandModel::bind_keypoints).
 Joint KeypointJoint(int keypoint);
+// The thumb's CMC keypoint.
+inline constexpr int kThumbBaseKeypoint = 1;
 // The keypoint of `joint` (-1 for the four finger metacarpals, which have none).
 int JointKeypoint(int joint);
 // A short name of keypoint k ("index_pip").

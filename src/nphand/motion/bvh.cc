@@ -67,14 +67,15 @@ void WriteHierarchy(const HandModel& hand, double scale, int joint, int depth, s
       << (parent < 0 ? "6 Xposition Yposition Zposition Zrotation Xrotation Yrotation" : "3 Zrotation Xrotation Yrotation")
       << "\n";
   if (parent < 0) {
-    // The thumb's base (its CMC keypoint) is fixed to the wrist: a joint without channels,
-    // whose end site is the thumb's pivot.
+    // The thumb's base (its CMC keypoint) is fixed to the wrist: a joint whose rotation
+    // channels stay zero (readers that expect three per joint read it), whose end site is
+    // the thumb's pivot.
     const int pivot = Index(Joint::kThumbMetacarpal);
-    const Eigen::Vector3d base = hand.bind_keypoints()[JointKeypoint(pivot)];
+    const Eigen::Vector3d base = hand.bind_keypoints()[kThumbBaseKeypoint];
     const std::string inner = indent + "  ";
     out << inner << "JOINT " << kBvhThumbBase << "\n" << inner << "{\n";
     out << inner << "  OFFSET " << Vector(kBvhUnitsPerMetre * scale * (base - hand.bind_joint_positions()[joint])) << "\n";
-    out << inner << "  CHANNELS 0\n";
+    out << inner << "  CHANNELS 3 Zrotation Xrotation Yrotation\n";
     out << inner << "  End Site\n" << inner << "  {\n" << inner << "    OFFSET "
         << Vector(kBvhUnitsPerMetre * scale * (hand.bind_joint_positions()[pivot] - base)) << "\n"
         << inner << "  }\n";
@@ -119,7 +120,7 @@ std::string BvhText(const HandModel& hand, const Motion& motion) {
     for (int joint : order) {
       if (joint == Index(Joint::kWrist)) {
         out << Vector(kBvhUnitsPerMetre * (world_from_camera * frame.wrist_camera)) << " "
-            << Vector(ZxyDegrees(world_from_camera * frame.pose.camera_from_hand * turn[joint]));
+            << Vector(ZxyDegrees(world_from_camera * frame.pose.camera_from_hand * turn[joint])) << " 0 0 0";
       } else {
         out << " " << Vector(ZxyDegrees(turn[JointParent(joint)].transpose() * turn[joint]));
       }
@@ -298,9 +299,13 @@ Keypoints3d BvhKeypoints(const Bvh& bvh, size_t frame) {
   Keypoints3d keypoints;
   for (int k = 0; k < kNumKeypoints; ++k) {
     const int joint = Index(KeypointJoint(k));
-    const std::string name = IsTipJoint(joint)                       ? std::string(JointName(static_cast<Joint>(joint - 1))) + " end"
-                             : joint == Index(Joint::kThumbMetacarpal) ? std::string(kBvhThumbBase)
-                                                                       : JointName(static_cast<Joint>(joint));
+    if (k == kThumbBaseKeypoint) {
+      NPHAND_THROW_CHECK(bvh.Find(kBvhThumbBase) >= 0, "BVH: no joint '", kBvhThumbBase,
+                         "' (the thumb's CMC keypoint; not an nphand file, or one written before 2026-12-07)");
+    }
+    const std::string name = k == kThumbBaseKeypoint ? std::string(kBvhThumbBase)
+                             : IsTipJoint(joint)     ? std::string(JointName(static_cast<Joint>(joint - 1))) + " end"
+                                                     : std::string(JointName(static_cast<Joint>(joint)));
     const int j = bvh.Find(name);
     NPHAND_THROW_CHECK(j >= 0, "BVH: no joint '", name, "' (not a generic-hand skeleton)");
     keypoints[k] = camera_from_world * positions[j] / kBvhUnitsPerMetre;

@@ -2,10 +2,10 @@
 //
 // nphand's BVH: the root is the wrist (6 channels: Xposition Yposition Zposition Zrotation
 // Xrotation Yrotation), every other joint of the generic hand has 3 rotation channels
-// (Zrotation Xrotation Yrotation), the five fingertips are End Sites; 20 joints with
-// channels and 5 end sites. A joint "thumb-base" without channels, a child of the wrist,
-// stands at the thumb's CMC keypoint (the thumb's base, behind the asset's thumb pivot:
-// HandModel::bind_keypoints), its end site at the pivot. Units are centimetres, the world
+// (Zrotation Xrotation Yrotation), the five fingertips are End Sites. A joint "thumb-base",
+// a child of the wrist whose rotation channels stay zero, stands at the thumb's CMC keypoint
+// (the thumb's base, behind the asset's thumb pivot: HandModel::bind_keypoints), its end
+// site at the pivot: 21 joints with channels and 6 end sites. Units are centimetres, the world
 // frame is WorldFromCamera()'s.
 // In the rest pose (all channels zero) the skeleton is the model's bind pose, an open flat
 // hand with its back towards +z, fingers towards +x and (right hand) thumb towards +y,

@@ -172,7 +172,7 @@ std::vector<uint8_t> GltfMotionBytes(const HandModel& hand, std::span<const uint
   tinygltf::Node thumb_base;
   thumb_base.name = kGltfThumbBaseNode;
   const Eigen::Vector3d base =
-      rest[0].Matrix().inverse() * (hand.hand_from_mesh().inverse() * hand.bind_keypoints()[JointKeypoint(Index(Joint::kThumbMetacarpal))]);
+      rest[0].Matrix().inverse() * (hand.hand_from_mesh().inverse() * hand.bind_keypoints()[kThumbBaseKeypoint]);
   thumb_base.translation = {base.x(), base.y(), base.z()};
   gltf.nodes[nodes[0]].children.push_back(static_cast<int>(gltf.nodes.size()));
   gltf.nodes.push_back(thumb_base);
@@ -314,8 +314,8 @@ Keypoints3d GltfKeypoints(const GltfMotion& motion, size_t frame) {
                      "' (the thumb's CMC keypoint; not an nphand file, or one written before 2026-12-07)");
   Keypoints3d keypoints;
   for (int k = 0; k < kNumKeypoints; ++k) {
-    const int joint = Index(KeypointJoint(k));
-    keypoints[k] = camera_from_world * (joint == Index(Joint::kThumbMetacarpal) ? motion.thumb_bases[frame] : motion.frames[frame][joint]);
+    keypoints[k] = camera_from_world * (k == kThumbBaseKeypoint ? motion.thumb_bases[frame]
+                                                                : motion.frames[frame][Index(KeypointJoint(k))]);
   }
   return keypoints;
 }
