@@ -135,6 +135,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   estimator_options.carry_apart_frames = options.carry_apart_frames;
   estimator_options.skin.face_chroma = options.face_chroma;
   estimator_options.arm_agreement = options.arm_agreement;
+  estimator_options.objects = options.objects;
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, index, hand, estimator_options);
@@ -160,6 +161,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["carry_apart_frames"] = options.carry_apart_frames;
   result.figures["face_chroma"] = options.face_chroma;
   result.figures["arm_agreement"] = options.arm_agreement;
+  result.figures["objects"] = options.objects;
   result.figures["given_box"] = options.given_box;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {

@@ -93,6 +93,7 @@ struct EvalRealCommandOptions : EstimatorFiles {
   int carry_apart_frames = EstimatorOptions{}.carry_apart_frames;  // a track's first frames carry one hypothesis per mode
   double face_chroma = SkinOptions{}.face_chroma;  // skin only near a face's colours while one is in view (0: off)
   double arm_agreement = EstimatorOptions{}.arm_agreement;  // hypotheses turned against the arm cut off weigh less
+  bool objects = true;  // false: the hands hold nothing (EstimatorOptions::objects)
   // The hand's place given: each labelled hand estimated within its found region (the
   // pose alone judged, apart from finding the hand).
   bool given_box = false;

@@ -52,6 +52,10 @@ constexpr const char* kArmAgreementHelp =
     "Where a forearm was cut off, how much less a hypothesis weighs whose wrist is turned away from the arm "
     "(log weight per unit of disagreement; 0: the arm is not looked at)";
 
+// --no-object of estimate and eval real (EstimatorOptions::objects).
+constexpr const char* kNoObjectHelp =
+    "The hand holds nothing (gestures, an empty hand): the database's views with an object are not weighed";
+
 // For options held in unsigned fields, which would take "-1" as a huge number.
 CLI::Validator WholeNumber() {
   return CLI::Validator(
@@ -230,6 +234,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--face-chroma", e.skin.face_chroma, kFaceChromaHelp)->capture_default_str();
   cmd->add_flag("!--no-forearm-cut", e.cut_forearm, "Do not cut the forearm at the wrist");
   cmd->add_option("--arm-agreement", e.arm_agreement, kArmAgreementHelp)->capture_default_str();
+  cmd->add_flag("!--no-object", e.objects, kNoObjectHelp);
   cmd->add_option("--roi", o.roi, "x,y,width,height: seek the hand in this part of the frame only (skin elsewhere is ignored)")
       ->delimiter(',')
       ->expected(4);
@@ -495,6 +500,7 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
       ->capture_default_str();
   cmd->add_option("--face-chroma", o.face_chroma, kFaceChromaHelp)->capture_default_str();
   cmd->add_option("--arm-agreement", o.arm_agreement, kArmAgreementHelp)->capture_default_str();
+  cmd->add_flag("!--no-object", o.objects, kNoObjectHelp);
   cmd->add_flag("--given-box", o.given_box,
                 "The hand's place given: each labelled hand estimated within its box grown by 25 % (its pose judged alone)");
   cmd->add_option("--hand", o.hand, "given (each labelled side searched for) or auto (the estimator chooses, and is scored)")

@@ -138,6 +138,45 @@ TEST_F(EstimatorTest, AFrameAtADatabaseEntryIsThatEntryAndARolledOneComesBackWit
   }
 }
 
+// With objects off (`--no-object`: the hand holds nothing) no view with an object is weighed:
+// the silhouette of a hand around an object is then the nearest empty hand's, and where
+// every neighbour holds an object the frame has no hand, and says why.
+TEST_F(EstimatorTest, AHandHoldingNothingIsNoViewWithAnObject) {
+  // A view whose object hides some of the hand (elsewhere its mask is the empty hand's).
+  Estimator with(*db_, *index_, RightHand(), Options());
+  cv::Mat mask;
+  FrameResult held;
+  for (size_t e = 0; e < db_->size() && mask.empty(); ++e) {
+    if (!db_->Meta(e).with_object || !db_->Meta(e).has_hand) continue;
+    const RenderedImages images = with.RenderEntry(static_cast<uint32_t>(e));
+    with.Reset();
+    held = with.ProcessMask(images.labels == static_cast<int>(PixelLabel::kHand), 0.0);
+    if (held.detected() && held.top[0].entry == e && held.nearest_distance < 1e-3) {
+      mask = images.labels == static_cast<int>(PixelLabel::kHand);
+    }
+  }
+  ASSERT_FALSE(mask.empty());
+
+  EstimatorOptions options = Options();
+  options.objects = false;
+  Estimator without(*db_, *index_, RightHand(), options);
+  const FrameResult empty = without.ProcessMask(mask, 0.0);
+  ASSERT_TRUE(empty.detected()) << empty.reason;
+  for (const Hypothesis& h : empty.top) EXPECT_FALSE(db_->Meta(h.entry).with_object) << h.entry;
+  ASSERT_EQ(empty.objects.size(), 1u);
+  EXPECT_EQ(empty.objects[0].first, "none");
+  EXPECT_GT(empty.nearest_distance, held.nearest_distance);
+
+  options.k = 1;  // the view itself, alone: one crop, no track's views
+  options.carried = options.top_n = 1;
+  options.roll_ambiguity = 0.0;
+  options.track_views = 0;
+  Estimator one(*db_, *index_, RightHand(), options);
+  const FrameResult none = one.ProcessMask(mask, 0.0);
+  EXPECT_EQ(none.status, FrameStatus::kNotAHand);
+  EXPECT_NE(none.reason.find("holds an object, and the hand holds none"), std::string::npos) << none.reason;
+}
+
 // In a database built with gestures, a victory sign, a thumbs-up and a fist seen from views
 // between the database's are named, and the estimate's fingers are straight or curled as
 // the gesture's are.

@@ -762,6 +762,7 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
   hyp.reserve(total);
   for (size_t c = 0; c < found.size(); ++c) {
     for (size_t i = 0; i < found[c].ids.size(); ++i) {
+      if (!options_.objects && entries_[found[c].ids[i]].meta.with_object) continue;
       Candidate h;
       h.entry = found[c].ids[i];
       h.turn_of = static_cast<int>(c);
@@ -781,7 +782,14 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
       hyp.push_back(std::move(h));
     }
   }
-  NPHAND_CHECK(!hyp.empty(), "the index returned no neighbours");
+  if (hyp.empty()) {
+    NPHAND_CHECK(!options_.objects, "the index returned no neighbours");
+    result->status = FrameStatus::kNotAHand;
+    result->reason = "every view in the database near this region holds an object, and the hand holds none (--no-object)";
+    result->box = box;
+    result->ms.weigh = Ms(t, Clock::now());
+    return false;
+  }
   double nearest = hyp[0].distance;
   for (const Candidate& h : hyp) nearest = std::min(nearest, h.distance);
   result->searched = true;

@@ -116,6 +116,11 @@ struct EstimatorOptions {
   // validation sweep's choice: 4 (16.50 -> 15.74 mm, jitter 7.00 -> 6.84, frames turned
   // 21 -> 17; 8 turns 10 but shakes more; docs/estimator.md).
   double arm_agreement = 4.0;
+  // The hand may hold an object (the paper's object context). False where the user knows it
+  // holds nothing (gestures, an empty hand): the entries rendered with an object are not
+  // weighed, for their objects hide fingers that an empty hand shows curled (on real-dev's
+  // video, finger states 909 -> 927 of 1300; docs/estimator.md).
+  bool objects = true;
   int learn_interval = 10;                      // frames between skin-colour updates from confident frames
   // Refinement beyond the database (refine/refiner.h): the best hypothesis's pose moved
   // until its silhouette agrees with the hand's; keypoints, angles and rotation then come
