@@ -299,15 +299,14 @@ Keypoints3d BvhKeypoints(const Bvh& bvh, size_t frame) {
   Keypoints3d keypoints;
   for (int k = 0; k < kNumKeypoints; ++k) {
     const int joint = Index(KeypointJoint(k));
-    if (k == kThumbBaseKeypoint) {
-      NPHAND_THROW_CHECK(bvh.Find(kBvhThumbBase) >= 0, "BVH: no joint '", kBvhThumbBase,
-                         "' (the thumb's CMC keypoint; not an nphand file, or one written before 2026-12-07)");
-    }
     const std::string name = k == kThumbBaseKeypoint ? std::string(kBvhThumbBase)
                              : IsTipJoint(joint)     ? std::string(JointName(static_cast<Joint>(joint - 1))) + " end"
                                                      : std::string(JointName(static_cast<Joint>(joint)));
     const int j = bvh.Find(name);
-    NPHAND_THROW_CHECK(j >= 0, "BVH: no joint '", name, "' (not a generic-hand skeleton)");
+    NPHAND_THROW_CHECK(j >= 0, "BVH: no joint '", name, "' (",
+                       k == kThumbBaseKeypoint ? "the thumb's CMC keypoint; not an nphand file, or one written before 2026-12-07"
+                                               : "not a generic-hand skeleton",
+                       ")");
     keypoints[k] = camera_from_world * positions[j] / kBvhUnitsPerMetre;
   }
   return keypoints;
