@@ -107,6 +107,23 @@ TEST(RealEvalTest, WithTheBoxGivenEachLabelledHandIsEstimatedInItsRegion) {
     EXPECT_GE(centre.x(), labels[h].region[0]) << h;
     EXPECT_LE(centre.x(), labels[h].region[2]) << h;
   }
+
+  // A labelled image without skin: no hand, and the estimate's word for it kept.
+  ASSERT_TRUE(cv::imwrite((dir / "images" / "wall.png").string(), cv::Mat(180, 240, CV_8UC3, cv::Scalar(160, 90, 40))));
+  {
+    nlohmann::json keypoints = nlohmann::json::array();
+    for (const Eigen::Vector2d& k : frame.keypoints_2d) keypoints.push_back({k.x(), k.y()});
+    std::ofstream out(dir / "wall.jsonl");
+    out << nlohmann::json({{"file", "images/wall.png"}, {"hand", "right"}, {"keypoints_2d_px", keypoints}}).dump() << "\n";
+  }
+  const std::vector<RealLabel> wall = ReadRealLabels(dir / "wall.jsonl");
+  const std::vector<RealPrediction> none = EstimateReal(wall, dir, &right, &left, false, nullptr);
+  ASSERT_EQ(none.size(), 1u);
+  EXPECT_TRUE(none[0].hands.empty());
+  ASSERT_EQ(none[0].missed.size(), 1u);
+  EXPECT_EQ(none[0].missed[0].first, "no_skin");
+  EXPECT_EQ(none[0].missed[0].second, "no skin-coloured region");
+  EXPECT_EQ(ScoreReal(wall, none).hands[0].miss, "no_skin");
 }
 
 }  // namespace

@@ -86,6 +86,44 @@ TEST(RealScoreTest, FoundPckAndHandednessFollowTheDefinitions) {
   EXPECT_EQ(ToJson(score)["overall"]["gt_all"]["found"], 3);
 }
 
+TEST(RealScoreTest, AHandNotFoundSaysWhy) {
+  const auto dir = testing::ScratchDir();
+  const nlohmann::json a = Keypoints(100, 100);
+  std::vector<nlohmann::json> lines;
+  for (int i = 1; i <= 4; ++i) lines.push_back({{"file", "images/freihand_" + std::to_string(i) + ".jpg"}, {"hand", "right"}, {"keypoints_2d_px", a}});
+  Write(dir / "labels.jsonl", lines);
+  const std::vector<RealLabel> labels = ReadRealLabels(dir / "labels.jsonl");
+  ASSERT_EQ(labels.size(), 4u);
+  // 1: a hand predicted off the labelled one; 2: none, and the estimate said why; 3: none,
+  // nothing said (another tool's predictions); 4: never run.
+  std::vector<RealPrediction> predictions(3);
+  predictions[0].file = labels[0].file;
+  PredictedHand far;
+  for (int k = 0; k < kNumKeypoints; ++k) far.keypoints_2d[k] = Eigen::Vector2d(900.0 + k, 900.0);
+  predictions[0].hands.push_back(far);
+  predictions[1].file = labels[1].file;
+  predictions[1].missed = {{"no_skin", "the frame has no colour (greyscale)"}, {"not_a_hand", "the second estimate's"}};
+  predictions[2].file = labels[2].file;
+  const RealScore score = ScoreReal(labels, predictions);
+  ASSERT_EQ(score.hands.size(), 4u);
+  for (const RealHandScore& r : score.hands) EXPECT_FALSE(r.found);
+  EXPECT_EQ(score.hands[0].miss, "elsewhere");
+  EXPECT_EQ(score.hands[1].miss, "no_skin") << "the first estimate's word";
+  EXPECT_EQ(score.hands[1].miss_reason, "the frame has no colour (greyscale)");
+  EXPECT_EQ(score.hands[2].miss, "no_hand");
+  EXPECT_EQ(score.hands[3].miss, "not_run");
+  const std::map<std::string, int> expected = {{"elsewhere", 1}, {"no_hand", 1}, {"no_skin", 1}, {"not_run", 1}};
+  EXPECT_EQ(score.gt_all.misses, expected);
+  EXPECT_EQ(score.gt_one_hand.misses, expected);
+  const nlohmann::json json = ToJson(score);
+  EXPECT_EQ(json["overall"]["gt_all"]["misses"]["no_skin"], 1);
+  EXPECT_EQ(json["per_hand"][1]["miss"], "no_skin");
+  EXPECT_EQ(json["per_hand"][1]["miss_reason"], "the frame has no colour (greyscale)");
+  EXPECT_FALSE(json["per_hand"][0].contains("miss_reason"));
+  EXPECT_NE(FormatTable(score).find("not found, GT overall: elsewhere 1, no_hand 1, no_skin 1, not_run 1"), std::string::npos)
+      << FormatTable(score);
+}
+
 TEST(RealScoreTest, PaMpjpeAndFingerStatesCompareTheShapeOnly) {
   const auto dir = testing::ScratchDir();
   Random random(testing::kTestSeed);

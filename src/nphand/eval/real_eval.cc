@@ -123,7 +123,11 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
       estimator->Reset();
       const FrameResult result = estimator->Process(bgr, 0.0, roi);
       *prediction.ms += result.ms.total;
-      if (result.detected()) prediction.hands.push_back(HandOf(result));
+      if (result.detected()) {
+        prediction.hands.push_back(HandOf(result));
+      } else {
+        prediction.missed.emplace_back(ToString(result.status), result.reason);
+      }
     }
     predictions.push_back(std::move(prediction));
     line.Update(++done);
@@ -148,7 +152,11 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
         prediction.file = file;
         prediction.frame = frame;
         prediction.ms = result.ms.total;
-        if (result.detected()) prediction.hands.push_back(HandOf(result));
+        if (result.detected()) {
+          prediction.hands.push_back(HandOf(result));
+        } else {
+          prediction.missed.emplace_back(ToString(result.status), result.reason);
+        }
         predictions.push_back(std::move(prediction));
       }
       line.Update(++done);

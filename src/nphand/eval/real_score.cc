@@ -7,6 +7,7 @@
 #include <numeric>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include <Eigen/Geometry>
 
@@ -144,6 +145,7 @@ RealAggregate Aggregate(const std::vector<const RealHandScore*>& rows, int extra
   for (const RealHandScore* r : rows) {
     a.found += r->found;
     a.not_run += !r->run;
+    if (!r->found) ++a.misses[r->miss];
     const bool keypoints = !r->label->labelled.empty();
     a.kp_hands += keypoints;
     if (r->label->source == "interhand" || r->label->source == "asl_video") ++a.hands_with_3d_label;
@@ -201,6 +203,7 @@ nlohmann::json ToJson(const RealAggregate& a) {
           {"images", a.images},
           {"found", a.found},
           {"found_rate", Optional(a.found_rate())},
+          {"misses", a.misses},
           {"not_run", a.not_run},
           {"extra_predictions", a.extra},
           {"kp_hands", a.kp_hands},
@@ -407,6 +410,17 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
       r.hands_in_image = static_cast<int>(image.size());
       r.run = prediction != nullptr;
       r.found = assign[i] >= 0;
+      if (!r.found) {
+        if (prediction == nullptr) {
+          r.miss = "not_run";
+        } else if (!hands.empty()) {
+          r.miss = "elsewhere";
+        } else if (!prediction->missed.empty()) {
+          std::tie(r.miss, r.miss_reason) = prediction->missed.front();
+        } else {
+          r.miss = "no_hand";
+        }
+      }
       if (r.found) {
         const PredictedHand& hand = hands[assign[i]];
         r.centroid = Centroid(hand.keypoints_2d);
@@ -483,6 +497,10 @@ nlohmann::json ToJson(const RealScore& score) {
                         {"labelled_hands_in_image", r.hands_in_image},
                         {"run", r.run},
                         {"found", r.found}};
+    if (!r.found) {
+      h["miss"] = r.miss;
+      if (!r.miss_reason.empty()) h["miss_reason"] = r.miss_reason;
+    }
     if (r.found) {
       h["pred_centroid"] = {r.centroid->x(), r.centroid->y()};
       h["handedness_ok"] = r.handedness_ok.has_value() ? nlohmann::json(*r.handedness_ok) : nlohmann::json(nullptr);
@@ -549,6 +567,18 @@ std::string FormatTable(const RealScore& score) {
   out << "-- labels that are MediaPipe's own outputs (agreement with MediaPipe, not accuracy)\n";
   for (const char* source : kMediaPipeSources) {
     if (score.per_source.count(source)) row(source, score.per_source.at(source));
+  }
+  // Why the ground-truth hands not found were not.
+  for (const auto& [name, a] : {std::pair<const char*, const RealAggregate&>{"GT overall", score.gt_all},
+                                {"1-hand images", score.gt_one_hand}}) {
+    if (a.misses.empty()) continue;
+    out << "not found, " << name << ":";
+    const char* separator = " ";
+    for (const auto& [miss, n] : a.misses) {
+      out << separator << miss << " " << n;
+      separator = ", ";
+    }
+    out << "\n";
   }
   out << "timing: stills median " << figure(score.stills_median_ms, 1) << " ms, video frames median "
       << figure(score.video_median_ms, 1) << " ms\n";

@@ -38,6 +38,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -94,6 +95,9 @@ struct RealPrediction {
   std::optional<int> frame;
   std::vector<PredictedHand> hands;  // empty: no hand found
   std::optional<double> ms;
+  // What each estimate that found no hand said: its status (`ToString(FrameStatus)`) and
+  // reason. nphand's own runs only: the reference's format has no such field.
+  std::vector<std::pair<std::string, std::string>> missed;
   std::pair<std::string, int> key() const { return {file, frame.value_or(-1)}; }
 };
 
@@ -116,6 +120,11 @@ struct RealHandScore {
   std::optional<int> gesture_finger_agree;  // of 4: found hands whose label's gesture fixes its fingers
   std::optional<bool> facing_ok;      // found hands whose label's facing is judged
   std::optional<Eigen::Vector2d> centroid;  // the partner's keypoint centroid
+  // A hand not found: why. "elsewhere" (the image's predicted hands all lie off it), an
+  // estimate's status (RealPrediction::missed: "no_skin", "not_a_hand", ...), "not_run", or
+  // "no_hand" (a prediction without hands that says nothing more); `miss_reason` the
+  // estimate's own words, if any.
+  std::string miss, miss_reason;
 };
 
 struct RealAggregate {
@@ -128,6 +137,7 @@ struct RealAggregate {
   int finger_agree = 0, finger_total = 0;
   int gesture_finger_agree = 0, gesture_finger_total = 0;
   int facing_n = 0, facing_correct = 0;
+  std::map<std::string, int> misses;  // hands not found, by RealHandScore::miss
   std::optional<double> found_rate() const { return hands > 0 ? std::optional<double>(double(found) / hands) : std::nullopt; }
 };
 
