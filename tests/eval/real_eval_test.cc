@@ -121,8 +121,9 @@ TEST(RealEvalTest, WithTheBoxGivenEachLabelledHandIsEstimatedInItsRegion) {
   ASSERT_EQ(none.size(), 1u);
   EXPECT_TRUE(none[0].hands.empty());
   ASSERT_EQ(none[0].missed.size(), 1u);
-  EXPECT_EQ(none[0].missed[0].first, "no_skin");
-  EXPECT_EQ(none[0].missed[0].second, "no skin-coloured region");
+  EXPECT_EQ(none[0].missed[0].hand, "right");
+  EXPECT_EQ(none[0].missed[0].status, "no_skin");
+  EXPECT_FALSE(none[0].missed[0].reason.empty());
   EXPECT_EQ(ScoreReal(wall, none).hands[0].miss, "no_skin");
 }
 

@@ -88,40 +88,60 @@ TEST(RealScoreTest, FoundPckAndHandednessFollowTheDefinitions) {
 
 TEST(RealScoreTest, AHandNotFoundSaysWhy) {
   const auto dir = testing::ScratchDir();
-  const nlohmann::json a = Keypoints(100, 100);
+  const nlohmann::json a = Keypoints(100, 100), b = Keypoints(400, 100);
   std::vector<nlohmann::json> lines;
   for (int i = 1; i <= 4; ++i) lines.push_back({{"file", "images/freihand_" + std::to_string(i) + ".jpg"}, {"hand", "right"}, {"keypoints_2d_px", a}});
+  for (int i = 5; i <= 6; ++i) {
+    const std::string file = "images/panoptic_" + std::to_string(i) + ".jpg";
+    lines.push_back({{"file", file}, {"hand", "right"}, {"keypoints_2d_px", a}});
+    lines.push_back({{"file", file}, {"hand", "left"}, {"keypoints_2d_px", b}});
+  }
   Write(dir / "labels.jsonl", lines);
   const std::vector<RealLabel> labels = ReadRealLabels(dir / "labels.jsonl");
-  ASSERT_EQ(labels.size(), 4u);
-  // 1: a hand predicted off the labelled one; 2: none, and the estimate said why; 3: none,
-  // nothing said (another tool's predictions); 4: never run.
-  std::vector<RealPrediction> predictions(3);
-  predictions[0].file = labels[0].file;
-  PredictedHand far;
-  for (int k = 0; k < kNumKeypoints; ++k) far.keypoints_2d[k] = Eigen::Vector2d(900.0 + k, 900.0);
+  ASSERT_EQ(labels.size(), 8u);
+  PredictedHand far, on_a;
+  for (int k = 0; k < kNumKeypoints; ++k) {
+    far.keypoints_2d[k] = Eigen::Vector2d(900.0 + k, 900.0);
+    on_a.keypoints_2d[k] = Eigen::Vector2d(a[k][0].get<double>(), a[k][1].get<double>());
+  }
+  on_a.hand = "right";
+  std::vector<RealPrediction> predictions(5);
+  for (size_t p = 0; p < 3; ++p) predictions[p].file = labels[p].file;
+  // 1: a hand off the labelled one, and the other side's estimate found none (no answer
+  // for a right hand); 2: the right side's estimate said why; 3: nothing said (another
+  // tool's predictions); 4: never run.
   predictions[0].hands.push_back(far);
-  predictions[1].file = labels[1].file;
-  predictions[1].missed = {{"no_skin", "the frame has no colour (greyscale)"}, {"not_a_hand", "the second estimate's"}};
-  predictions[2].file = labels[2].file;
+  predictions[0].missed = {{"left", "no_skin", "the left side's"}};
+  predictions[1].missed = {{"right", "no_skin", "the frame has no colour (greyscale)"}};
+  // 5: the right hand found, the left side's estimate found nothing: its own word, not
+  // "elsewhere"; 6: both sides found nothing, each answering for its own side.
+  predictions[3].file = labels[4].file;
+  predictions[3].hands.push_back(on_a);
+  predictions[3].missed = {{"left", "not_a_hand", "the left hand's"}};
+  predictions[4].file = labels[6].file;
+  predictions[4].missed = {{"left", "not_a_hand", "the left hand's"}, {"right", "no_skin", "the right hand's"}};
   const RealScore score = ScoreReal(labels, predictions);
-  ASSERT_EQ(score.hands.size(), 4u);
-  for (const RealHandScore& r : score.hands) EXPECT_FALSE(r.found);
-  EXPECT_EQ(score.hands[0].miss, "elsewhere");
-  EXPECT_EQ(score.hands[1].miss, "no_skin") << "the first estimate's word";
-  EXPECT_EQ(score.hands[1].miss_reason, "the frame has no colour (greyscale)");
-  EXPECT_EQ(score.hands[2].miss, "no_hand");
-  EXPECT_EQ(score.hands[3].miss, "not_run");
-  const std::map<std::string, int> expected = {{"elsewhere", 1}, {"no_hand", 1}, {"no_skin", 1}, {"not_run", 1}};
-  EXPECT_EQ(score.gt_all.misses, expected);
-  EXPECT_EQ(score.gt_one_hand.misses, expected);
+  ASSERT_EQ(score.hands.size(), 8u);
+  std::vector<std::pair<std::string, std::string>> got;
+  for (const RealHandScore& r : score.hands) got.emplace_back(r.found ? "found" : r.miss, r.miss_reason);
+  const std::vector<std::pair<std::string, std::string>> expected = {
+      {"elsewhere", ""},        {"no_skin", "the frame has no colour (greyscale)"},
+      {"no_hand", ""},          {"not_run", ""},
+      {"found", ""},            {"not_a_hand", "the left hand's"},
+      {"no_skin", "the right hand's"}, {"not_a_hand", "the left hand's"}};
+  EXPECT_EQ(got, expected);
+  EXPECT_EQ(score.gt_all.misses, (std::map<std::string, int>{{"elsewhere", 1}, {"no_hand", 1}, {"no_skin", 2}, {"not_a_hand", 2}, {"not_run", 1}}));
+  EXPECT_EQ(score.gt_one_hand.misses, (std::map<std::string, int>{{"elsewhere", 1}, {"no_hand", 1}, {"no_skin", 1}, {"not_run", 1}}));
   const nlohmann::json json = ToJson(score);
-  EXPECT_EQ(json["overall"]["gt_all"]["misses"]["no_skin"], 1);
+  EXPECT_EQ(json["overall"]["gt_all"]["misses"]["no_skin"], 2);
   EXPECT_EQ(json["per_hand"][1]["miss"], "no_skin");
   EXPECT_EQ(json["per_hand"][1]["miss_reason"], "the frame has no colour (greyscale)");
   EXPECT_FALSE(json["per_hand"][0].contains("miss_reason"));
-  EXPECT_NE(FormatTable(score).find("not found, GT overall: elsewhere 1, no_hand 1, no_skin 1, not_run 1"), std::string::npos)
-      << FormatTable(score);
+  EXPECT_FALSE(json["per_hand"][4].contains("miss"));
+  const std::string table = FormatTable(score);
+  EXPECT_NE(table.find("not found, GT overall: elsewhere 1, no_hand 1, no_skin 2, not_a_hand 2, not_run 1\n"), std::string::npos)
+      << table;
+  EXPECT_NE(table.find("not found, 1-hand images: elsewhere 1, no_hand 1, no_skin 1, not_run 1\n"), std::string::npos) << table;
 }
 
 TEST(RealScoreTest, PaMpjpeAndFingerStatesCompareTheShapeOnly) {

@@ -54,6 +54,16 @@ PredictedHand HandOf(const FrameResult& result) {
   return hand;
 }
 
+// The estimate of `estimator` into `prediction`: its hand, or why it found none.
+void Record(const Estimator& estimator, const FrameResult& result, RealPrediction* prediction) {
+  if (result.detected()) {
+    prediction->hands.push_back(HandOf(result));
+    return;
+  }
+  const EstimatorOptions& options = estimator.options();
+  prediction->missed.push_back({options.hand_auto ? "" : ToString(options.hand), ToString(result.status), result.reason});
+}
+
 }  // namespace
 
 void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem::path& root) {
@@ -123,11 +133,7 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
       estimator->Reset();
       const FrameResult result = estimator->Process(bgr, 0.0, roi);
       *prediction.ms += result.ms.total;
-      if (result.detected()) {
-        prediction.hands.push_back(HandOf(result));
-      } else {
-        prediction.missed.emplace_back(ToString(result.status), result.reason);
-      }
+      Record(*estimator, result, &prediction);
     }
     predictions.push_back(std::move(prediction));
     line.Update(++done);
@@ -152,11 +158,7 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
         prediction.file = file;
         prediction.frame = frame;
         prediction.ms = result.ms.total;
-        if (result.detected()) {
-          prediction.hands.push_back(HandOf(result));
-        } else {
-          prediction.missed.emplace_back(ToString(result.status), result.reason);
-        }
+        Record(*estimator, result, &prediction);
         predictions.push_back(std::move(prediction));
       }
       line.Update(++done);

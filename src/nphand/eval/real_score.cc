@@ -7,7 +7,6 @@
 #include <numeric>
 #include <set>
 #include <sstream>
-#include <tuple>
 
 #include <Eigen/Geometry>
 
@@ -403,6 +402,8 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
     static const std::vector<PredictedHand> kNone;
     const std::vector<PredictedHand>& hands = prediction != nullptr ? prediction->hands : kNone;
     const std::vector<int> assign = Match(image, hands);
+    // Each estimate that found nothing answers for one hand not found of its side.
+    std::vector<bool> miss_used(prediction != nullptr ? prediction->missed.size() : 0, false);
     for (size_t i = 0; i < image.size(); ++i) {
       const RealLabel& label = *image[i];
       RealHandScore r;
@@ -411,17 +412,21 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
       r.run = prediction != nullptr;
       r.found = assign[i] >= 0;
       if (!r.found) {
+        size_t m = 0;
+        while (m < miss_used.size() &&
+               (miss_used[m] || !(prediction->missed[m].hand.empty() || prediction->missed[m].hand == label.hand))) {
+          ++m;
+        }
         if (prediction == nullptr) {
           r.miss = "not_run";
-        } else if (!hands.empty()) {
-          r.miss = "elsewhere";
-        } else if (!prediction->missed.empty()) {
-          std::tie(r.miss, r.miss_reason) = prediction->missed.front();
+        } else if (m < miss_used.size()) {
+          miss_used[m] = true;
+          r.miss = prediction->missed[m].status;
+          r.miss_reason = prediction->missed[m].reason;
         } else {
-          r.miss = "no_hand";
+          r.miss = hands.empty() ? "no_hand" : "elsewhere";
         }
-      }
-      if (r.found) {
+      } else {
         const PredictedHand& hand = hands[assign[i]];
         r.centroid = Centroid(hand.keypoints_2d);
         if (!hand.hand.empty()) r.handedness_ok = hand.hand == label.hand;

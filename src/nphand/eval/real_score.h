@@ -38,7 +38,6 @@
 #include <map>
 #include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -95,9 +94,14 @@ struct RealPrediction {
   std::optional<int> frame;
   std::vector<PredictedHand> hands;  // empty: no hand found
   std::optional<double> ms;
-  // What each estimate that found no hand said: its status (`ToString(FrameStatus)`) and
-  // reason. nphand's own runs only: the reference's format has no such field.
-  std::vector<std::pair<std::string, std::string>> missed;
+  // What each estimate that found no hand said. nphand's own runs only: the reference's
+  // format has no such field.
+  struct Miss {
+    std::string hand;    // the side it looked for ("right", "left"), or "" (either: --hand auto)
+    std::string status;  // ToString(FrameStatus)
+    std::string reason;
+  };
+  std::vector<Miss> missed;
   std::pair<std::string, int> key() const { return {file, frame.value_or(-1)}; }
 };
 
@@ -120,10 +124,10 @@ struct RealHandScore {
   std::optional<int> gesture_finger_agree;  // of 4: found hands whose label's gesture fixes its fingers
   std::optional<bool> facing_ok;      // found hands whose label's facing is judged
   std::optional<Eigen::Vector2d> centroid;  // the partner's keypoint centroid
-  // A hand not found: why. "elsewhere" (the image's predicted hands all lie off it), an
-  // estimate's status (RealPrediction::missed: "no_skin", "not_a_hand", ...), "not_run", or
-  // "no_hand" (a prediction without hands that says nothing more); `miss_reason` the
-  // estimate's own words, if any.
+  // A hand not found: why. The status of the estimate that looked for its side and found
+  // nothing (RealPrediction::missed: "no_skin", "not_a_hand"), else "elsewhere" (hands were
+  // estimated, all off it), "not_run", or "no_hand" (a prediction without hands that says
+  // nothing more); `miss_reason` the estimate's own words, if any.
   std::string miss, miss_reason;
 };
 
