@@ -505,8 +505,7 @@ nlohmann::json ToJson(const RealScore& score) {
     if (!r.found) {
       h["miss"] = r.miss;
       if (!r.miss_reason.empty()) h["miss_reason"] = r.miss_reason;
-    }
-    if (r.found) {
+    } else {
       h["pred_centroid"] = {r.centroid->x(), r.centroid->y()};
       h["handedness_ok"] = r.handedness_ok.has_value() ? nlohmann::json(*r.handedness_ok) : nlohmann::json(nullptr);
       if (r.mean_norm_err.has_value()) {
