@@ -209,7 +209,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--prior", o.prior, "Temporal prior: none, product (the paper) or sum (the released code)")->capture_default_str();
   cmd->add_option("--sigma-x", e.sigma_x, "Prior kernel width, pose-vector units")->capture_default_str();
   cmd->add_option("--prior-share", e.prior_share, "The weighted sum's share of the prior")->capture_default_str();
-  cmd->add_option("--carried", e.carried, "Hypotheses carried to the next frame")->capture_default_str();
+  cmd->add_option("--carried", e.carried, "Hypotheses carried to the next frame (1 to --k)")->capture_default_str();
   cmd->add_option("--carry-apart", e.carry_apart_frames,
                   "In a track's first N frames, carry hypotheses at least --sigma-x apart in pose (one per mode; 0: never)")
       ->check(WholeNumber())
@@ -493,7 +493,7 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_option("--track-views", o.track_views,
                   "In a track, also measure the entries of this many viewpoints nearest the last best view's (0: none)")
       ->capture_default_str();
-  cmd->add_option("--carried", o.carried, "Hypotheses carried to the next frame")->capture_default_str();
+  cmd->add_option("--carried", o.carried, "Hypotheses carried to the next frame (1 to --k)")->capture_default_str();
   cmd->add_option("--carry-apart", o.carry_apart_frames,
                   "In a track's first N frames, carry hypotheses at least sigma_x apart in pose (one per mode; 0: never)")
       ->check(WholeNumber())
