@@ -411,18 +411,16 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
       r.hands_in_image = static_cast<int>(image.size());
       r.run = prediction != nullptr;
       r.found = assign[i] >= 0;
-      if (!r.found) {
+      if (!r.found && prediction == nullptr) {
+        r.miss = "not_run";
+      } else if (!r.found) {
+        const std::vector<RealPrediction::Miss>& missed = prediction->missed;
         size_t m = 0;
-        while (m < miss_used.size() &&
-               (miss_used[m] || !(prediction->missed[m].hand.empty() || prediction->missed[m].hand == label.hand))) {
-          ++m;
-        }
-        if (prediction == nullptr) {
-          r.miss = "not_run";
-        } else if (m < miss_used.size()) {
+        while (m < missed.size() && (miss_used[m] || !(missed[m].hand.empty() || missed[m].hand == label.hand))) ++m;
+        if (m < missed.size()) {
           miss_used[m] = true;
-          r.miss = prediction->missed[m].status;
-          r.miss_reason = prediction->missed[m].reason;
+          r.miss = missed[m].status;
+          r.miss_reason = missed[m].reason;
         } else {
           r.miss = hands.empty() ? "no_hand" : "elsewhere";
         }
