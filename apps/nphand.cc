@@ -245,6 +245,11 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_flag("--smooth,!--no-smooth", e.smooth, "Smooth the track's poses over time (a One Euro filter)")->capture_default_str();
   cmd->add_option("--smooth-cutoff", e.smoothing.min_cutoff_hz, "Smoothing: the cutoff of a still hand, Hz")->capture_default_str();
   cmd->add_option("--smooth-beta", e.smoothing.beta, "Smoothing: the cutoff's rise with the hand's speed")->capture_default_str();
+  cmd->add_option("--smooth-rotation-cutoff", e.rotation_smoothing.min_cutoff_hz, "Smoothing: the cutoff of a still wrist's rotation, Hz")
+      ->capture_default_str();
+  cmd->add_option("--smooth-rotation-trend", e.rotation_smoothing.trend,
+                  "Smoothing: how far the rotation is predicted from its smoothed rate (0 to 1)")
+      ->capture_default_str();
   cmd->add_option("--fps", o.fps, "Frame rate of an image folder")->capture_default_str();
   cmd->add_option("--max-frames", o.max_frames, "Stop after this many frames (0: all)")->check(WholeNumber())->capture_default_str();
   cmd->callback([&o]() {

@@ -210,7 +210,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the arm's agreement must be within [0, 100]";
   } else if (learn_interval < 1) {
     *why = "the learning interval must be at least 1 frame";
-  } else if (!skin.Check(why) || !forearm.Check(why) || !refinement.Check(why) || !smoothing.Check(why)) {
+  } else if (!skin.Check(why) || !forearm.Check(why) || !refinement.Check(why) || !smoothing.Check(why) ||
+             !rotation_smoothing.Check(why)) {
     return false;
   } else {
     return true;
@@ -227,9 +228,13 @@ nlohmann::json RefinementJson(const EstimatorOptions& options) {
 
 nlohmann::json SmoothingJson(const EstimatorOptions& options) {
   if (!options.smooth) return false;
-  return {{"min_cutoff_hz", options.smoothing.min_cutoff_hz},
-          {"beta", options.smoothing.beta},
-          {"derivative_cutoff_hz", options.smoothing.derivative_cutoff_hz}};
+  auto settings = [](const SmoothOptions& s) {
+    return nlohmann::json{
+        {"min_cutoff_hz", s.min_cutoff_hz}, {"beta", s.beta}, {"derivative_cutoff_hz", s.derivative_cutoff_hz}, {"trend", s.trend}};
+  };
+  nlohmann::json j = settings(options.smoothing);
+  j["rotation"] = settings(options.rotation_smoothing);
+  return j;
 }
 
 void SetHandChoice(const std::string& text, EstimatorOptions* options) {
@@ -277,7 +282,7 @@ Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel&
       smooth_wrist_(options.smoothing),
       smooth_image_(options.smoothing),
       smooth_angles_(options.smoothing),
-      smooth_rotation_(options.smoothing),
+      smooth_rotation_(options.rotation_smoothing),
       side_(options.hand) {
   std::string why;
   NPHAND_THROW_CHECK(options.Check(&why), "estimator: ", why);

@@ -25,6 +25,10 @@ bool SmoothOptions::Check(std::string* why) const {
     *why = "the smoothing's beta must be within [0, 1000]";
     return false;
   }
+  if (!(trend >= 0.0 && trend <= 1.0)) {
+    *why = "the smoothing's trend must be within [0, 1]";
+    return false;
+  }
   return true;
 }
 
@@ -44,7 +48,8 @@ Eigen::VectorXd OneEuroFilter::Filter(const Eigen::VectorXd& x, double scale, do
   const Eigen::VectorXd smooth_rate = last_->rate + Alpha(options_.derivative_cutoff_hz, dt) * (rate - last_->rate);
   const double speed = x.size() > 0 ? smooth_rate.norm() / std::sqrt(static_cast<double>(x.size())) / scale : 0.0;
   const double cutoff = options_.min_cutoff_hz + options_.beta * speed;
-  const Eigen::VectorXd out = last_->x + Alpha(cutoff, dt) * (x - last_->x);
+  const Eigen::VectorXd predicted = last_->x + options_.trend * dt * last_->rate;
+  const Eigen::VectorXd out = predicted + Alpha(cutoff, dt) * (x - predicted);
   last_ = State{out, smooth_rate, time_s};
   return out;
 }

@@ -2,7 +2,9 @@
 // CHI 2012), the low-pass filter whose cutoff rises with the signal's speed, so that a
 // still hand stops shaking and a moving one does not lag. Each group of numbers (the
 // keypoints about the wrist, in the camera, in the image; the joint angles; the wrist's
-// quaternion) is filtered with one cutoff, from the group's speed in its own scale.
+// quaternion) is filtered with one cutoff, from the group's speed in its own scale. With a
+// trend, each value is first predicted from the filter's smoothed rate (Holt's double
+// exponential smoothing): a steady motion is then followed without lag at a lower cutoff.
 #pragma once
 
 #include <optional>
@@ -17,6 +19,11 @@ struct SmoothOptions {
   double min_cutoff_hz = 4.0;  // the cutoff of a still signal
   double beta = 0.5;           // the cutoff's rise per unit of speed (the group's scale per second)
   double derivative_cutoff_hz = 1.0;
+  // How far each value is predicted from the last by the smoothed rate before the new one
+  // is weighed in: 0 (the One Euro filter as published) to 1 (the whole rate). On a ramp
+  // the filter lags by (1 - a)(1 - trend) / (a + (1 - a) trend) frames' motion, a the new
+  // value's weight: 0 with trend 1.
+  double trend = 0.0;
   bool Check(std::string* why) const;
 };
 

@@ -108,7 +108,7 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
     e.refine_both_turns = false;
   });
   // Smoothing over time (estimate/smoother.h): the One Euro filter's cutoff at rest and its
-  // rise with speed.
+  // rise with speed (the rotation's filter kept at its default) ...
   for (double cutoff : {0.5, 1.0, 2.0, 4.0}) {
     for (double beta : {0.5, 2.0, 5.0}) {
       std::ostringstream name;
@@ -119,6 +119,29 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
         e.smoothing.beta = beta;
       });
     }
+  }
+  // ... and the rotation's: its cutoff at rest, its rise with speed, its rate's cutoff and
+  // its trend (`smooth-rotation-c4-b0.5-d1-t0` is the rotation as the other groups).
+  struct RotationSmoothing {
+    double cutoff, beta, derivative, trend;
+  };
+  for (const RotationSmoothing& r : std::vector<RotationSmoothing>{{4.0, 0.5, 1.0, 0.0},
+                                                                   {2.0, 0.5, 1.0, 0.0},
+                                                                   {2.0, 0.5, 0.5, 0.0},
+                                                                   {4.0, 0.5, 0.5, 0.5},
+                                                                   {3.0, 0.5, 0.5, 0.5},
+                                                                   {2.0, 0.0, 0.5, 0.5},
+                                                                   {2.0, 0.5, 0.5, 0.5},
+                                                                   {2.0, 1.0, 0.5, 0.5},
+                                                                   {2.0, 0.5, 0.25, 0.5},
+                                                                   {2.0, 0.5, 0.5, 1.0},
+                                                                   {1.5, 0.5, 0.5, 0.5},
+                                                                   {1.0, 0.5, 0.5, 0.5}}) {
+    std::ostringstream name;
+    name << "smooth-rotation-c" << r.cutoff << "-b" << r.beta << "-d" << r.derivative << "-t" << r.trend;
+    around_default(name.str(), [&](EstimatorOptions& e) {
+      e.rotation_smoothing = {.min_cutoff_hz = r.cutoff, .beta = r.beta, .derivative_cutoff_hz = r.derivative, .trend = r.trend};
+    });
   }
   around_default("refine-place", [&](EstimatorOptions& e) {
     e.refine = true;
