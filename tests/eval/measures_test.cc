@@ -84,6 +84,36 @@ TEST(MeasuresTest, JitterIsTheMeanSecondDifference) {
   EXPECT_NEAR(runs.mean(), 0.002 / 10.0, 1e-12);
 }
 
+// The lag: an estimate that is the truth of two frames before agrees best two frames back;
+// frames without an estimate still give their truth; a new sequence does not reach into the
+// last one.
+TEST(MeasuresTest, TheLagIsTheShiftAtWhichTheTruthAgreesBest) {
+  Random random(testing::kTestSeed);
+  std::vector<Keypoints3d> truths;
+  for (int t = 0; t < 20; ++t) truths.push_back(RandomHand(random));
+  LagMeter none, exact, late;
+  EXPECT_FALSE(none.Lag().has_value());
+  for (int t = 0; t < 20; ++t) {
+    none.Add(truths[t], nullptr);
+    exact.Add(truths[t], &truths[t]);
+    late.Add(truths[t], t >= 2 && t % 5 != 0 ? &truths[t - 2] : nullptr);
+  }
+  EXPECT_FALSE(none.Lag().has_value());
+  EXPECT_EQ(exact.Lag(), 0);
+  EXPECT_EQ(late.Lag(), 2);
+  // A new sequence whose first estimate is the last sequence's last truth: one frame back
+  // it would agree exactly, but that frame is another sequence's.
+  LagMeter restarted, ran_on;
+  for (LagMeter* m : {&restarted, &ran_on}) {
+    for (int t = 0; t < 10; ++t) m->Add(truths[t], nullptr);
+  }
+  restarted.Restart();
+  restarted.Add(truths[10], &truths[9]);
+  ran_on.Add(truths[10], &truths[9]);
+  EXPECT_EQ(restarted.Lag(), 0);
+  EXPECT_EQ(ran_on.Lag(), 1);
+}
+
 TEST(MeasuresTest, MedianIsTheUpperMiddleValue) {
   EXPECT_EQ(Median({}), 0.0);
   EXPECT_EQ(Median({3.0, 1.0, 2.0}), 2.0);

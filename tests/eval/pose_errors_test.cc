@@ -1,6 +1,7 @@
 // Errors of poses against the truth, on lines written here: an exact copy has no error,
 // every keypoint within 20 mm and an AUC of 1; a turned copy keeps no error after the
-// Procrustes alignment; jitter is measured over runs of detected frames only.
+// Procrustes alignment; jitter is measured over runs of detected frames only; a copy a frame
+// late lags by one.
 #include "nphand/eval/pose_errors.h"
 
 #include <fstream>
@@ -69,6 +70,7 @@ TEST_F(PoseErrorsTest, AnExactCopyHasNoErrorAndATurnedOneNoneAfterAlignment) {
   EXPECT_DOUBLE_EQ(same.auc_0_50, 1.0);
   EXPECT_NEAR(same.jitter_mm, same.truth_jitter_mm, 1e-9);
   EXPECT_GT(same.truth_jitter_mm, 0.0);
+  EXPECT_EQ(same.lag_frames, 0);
 
   const PoseErrorSummary other = ComparePoses(dir / "truth.jsonl", Write(dir / "turned.jsonl", turned));
   EXPECT_GT(other.mean[2], 5.0) << "keypoint_mm sees the turn";
@@ -97,6 +99,19 @@ TEST_F(PoseErrorsTest, JitterSkipsTheGapsOfUndetectedFrames) {
   EXPECT_NEAR(s.jitter_mm, 0.0, 1e-9);
   EXPECT_NEAR(s.truth_jitter_mm, 0.0, 1e-9);
 }
+TEST_F(PoseErrorsTest, ACopyAFrameLateLagsByOne) {
+  const auto dir = testing::ScratchDir();
+  std::vector<nlohmann::json> truth, late;
+  for (int f = 0; f < 8; ++f) {
+    truth.push_back(Line(f, true, hands_[f]));
+    late.push_back(Line(f, f > 0, hands_[std::max(f - 1, 0)]));
+  }
+  const PoseErrorSummary s = ComparePoses(Write(dir / "truth.jsonl", truth), Write(dir / "late.jsonl", late));
+  EXPECT_EQ(s.lag_frames, 1);
+  EXPECT_EQ(ToJson(s)["lag_frames"], 1);
+  EXPECT_NE(FormatTable(s).find("lag behind the truth 1 frame ("), std::string::npos) << FormatTable(s);
+}
+
 TEST_F(PoseErrorsTest, APartRunOrAnotherSequenceIsRefused) {
   const auto dir = testing::ScratchDir();
   std::vector<nlohmann::json> truth, poses;
@@ -149,7 +164,9 @@ TEST_F(PoseErrorsTest, NothingDetectedReadsAsNothingMeasuredNotAsPerfect) {
   const PoseErrorSummary s = ComparePoses(Write(dir / "truth.jsonl", truth), Write(dir / "poses.jsonl", poses));
   EXPECT_EQ(s.detected, 0);
   const nlohmann::json json = ToJson(s);
-  for (const char* key : {"within_20mm", "auc_0_50", "jitter_mm", "truth_jitter_mm"}) EXPECT_TRUE(json[key].is_null()) << key;
+  for (const char* key : {"within_20mm", "auc_0_50", "jitter_mm", "truth_jitter_mm", "lag_frames"}) {
+    EXPECT_TRUE(json[key].is_null()) << key;
+  }
   for (const auto& [name, value] : json["mean"].items()) EXPECT_TRUE(value.is_null()) << name;
   const std::string table = FormatTable(s);
   EXPECT_NE(table.find("detected 0 of 4 frames"), std::string::npos);

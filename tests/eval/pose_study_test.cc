@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "nphand/db/builder.h"
+#include "nphand/eval/measures.h"
 #include "nphand/eval/pose_methods.h"
 #include "nphand/eval/pose_report.h"
 #include "nphand/index/exact_index.h"
@@ -160,7 +161,11 @@ TEST_F(PoseStudyTest, TheEstimatorBeatsTheBaselinesAndNearsTheBound) {
     EXPECT_TRUE(std::isfinite(s.keypoint_mm) && std::isfinite(s.pa_mpjpe_mm) && std::isfinite(s.auc_0_50)) << s.method;
     EXPECT_LE(s.pa_mpjpe_mm, s.keypoint_mm + 1e-9) << s.method << ": alignment can only help";
     EXPECT_EQ(std::isfinite(s.keypoint_px), s.method == "PNP" || s.method == "NN feature") << s.method << ": who places the hand";
+    ASSERT_TRUE(s.lag_frames.has_value()) << s.method;
+    EXPECT_TRUE(*s.lag_frames >= 0 && *s.lag_frames <= kMaxLag) << s.method;
   }
+  EXPECT_EQ(bound.lag_frames, 0) << "the truth's nearest pose, frame by frame, does not trail it";
+  EXPECT_EQ(ToJson(bound)["lag_frames"], 0);
   for (const char* metric : {"pose", "keypoints"}) {
     const auto value = [&](const MethodScore& s) { return std::string(metric) == "pose" ? s.pose_error : s.keypoint_mm; };
     EXPECT_LE(value(bound), value(estimator)) << metric << ": the database's resolution bounds the estimator";

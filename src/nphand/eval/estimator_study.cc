@@ -1,7 +1,6 @@
 #include "nphand/eval/estimator_study.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <iomanip>
 #include <numbers>
@@ -265,18 +264,17 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
       jitter.Add(run);
       run.clear();
     };
-    // Per shift of the estimate behind the truth (frames): the summed keypoint errors and their count.
-    std::array<double, kMaxLag + 1> lag_error{};
-    std::array<int, kMaxLag + 1> lag_count{};
+    LagMeter lag;
     for (const std::vector<SequenceFrame>& frames : sequences) {
       estimator.Reset();
       close_run();
-      for (size_t t = 0; t < frames.size(); ++t) {
-        const SequenceFrame& truth = frames[t];
+      lag.Restart();
+      for (const SequenceFrame& truth : frames) {
         const FrameResult r = options.masks ? estimator.ProcessMask(truth.labels == static_cast<int>(PixelLabel::kHand), truth.time_s)
                                             : estimator.Process(truth.rgb, truth.time_s);
         ++score.frames;
         ms.push_back(r.ms.total);
+        lag.Add(truth.keypoints, r.detected() ? &r.keypoints_hand : nullptr);
         if (!r.detected()) {
           close_run();
           continue;
@@ -290,12 +288,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
           px += (r.keypoints_2d[k] - truth.keypoints_2d[k]).norm();
           camera += (r.keypoints_camera[k] - (truth.wrist_in_camera + truth.keypoints[k])).norm();
         }
-        // The keypoints' error, and the same against the truth of each frame before (the lag's).
         const double keypoint = RootRelativeError(r.keypoints_hand, truth.keypoints);
-        for (size_t lag = 0; lag <= std::min<size_t>(kMaxLag, t); ++lag) {
-          lag_error[lag] += lag == 0 ? keypoint : RootRelativeError(r.keypoints_hand, frames[t - lag].keypoints);
-          ++lag_count[lag];
-        }
         score.joint_deg += joint / kNumDofs * 180.0 / std::numbers::pi;
         const double wrist = RotationAngleDeg(r.pose.camera_from_hand, truth.pose.camera_from_hand);
         score.wrist_deg += wrist;
@@ -314,15 +307,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     }
     close_run();
     score.jitter_mm = 1000.0 * jitter.mean();
-    double least = 1e300;
-    for (int lag = 0; lag <= kMaxLag; ++lag) {
-      if (lag_count[lag] == 0) continue;
-      const double mean = lag_error[lag] / lag_count[lag];
-      if (mean < least) {
-        least = mean;
-        score.lag_frames = lag;
-      }
-    }
+    score.lag_frames = lag.Lag().value_or(0);
     score.ms_median = Median(ms);
     scores.push_back(score);
     line.Update(scores.size());

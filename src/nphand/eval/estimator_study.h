@@ -49,9 +49,6 @@ std::vector<SequenceOptions> ValidationSequences(const EstimatorStudyOptions& op
 // A wrist this far from the truth is turned about 180 degrees: the wrist drawn at the
 // fingertips, a silhouette read end for end.
 inline constexpr double kTurnedDeg = 135.0;
-// The estimate's lag behind the truth is sought among shifts of 0..kMaxLag frames.
-inline constexpr int kMaxLag = 8;
-
 struct EstimatorScore {
   std::string name;
   nlohmann::json options;      // what differs from the base
@@ -66,8 +63,7 @@ struct EstimatorScore {
   double keypoint_px = 0.0;    // mean 2D keypoint error in the frame
   double camera_mm = 0.0;      // mean 3D keypoint error in the camera frame (includes the distance)
   double jitter_mm = 0.0;      // keypoints about the wrist: mean second difference over runs of detected frames (mm/frame²)
-  // The estimate's lag behind the truth: the shift (frames, 0..kMaxLag) of the truth at which
-  // the keypoints about the wrist agree best with it, over every detected frame.
+  // The estimate's lag behind the truth (LagMeter, measures.h; 0 with nothing detected).
   int lag_frames = 0;
   double ms_median = 0.0;      // per frame, the whole estimator
 };

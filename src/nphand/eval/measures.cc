@@ -92,6 +92,30 @@ void RunJitter::Add(std::span<const Keypoints3d> run) {
   count_ += n;
 }
 
+void LagMeter::Add(const Keypoints3d& truth, const Keypoints3d* estimate) {
+  truths_.push_front(truth);
+  if (truths_.size() > kMaxLag + 1) truths_.pop_back();
+  if (estimate == nullptr) return;
+  for (size_t lag = 0; lag < truths_.size(); ++lag) {
+    error_[lag] += RootRelativeError(*estimate, truths_[lag]);
+    ++count_[lag];
+  }
+}
+
+std::optional<int> LagMeter::Lag() const {
+  std::optional<int> best;
+  double least = 0.0;
+  for (int lag = 0; lag <= kMaxLag; ++lag) {
+    if (count_[lag] == 0) continue;
+    const double mean = error_[lag] / count_[lag];
+    if (!best || mean < least) {
+      best = lag;
+      least = mean;
+    }
+  }
+  return best;
+}
+
 Facing FacingOf(const std::optional<Eigen::Vector2d>& wrist, const std::optional<Eigen::Vector2d>& index_mcp,
                 const std::optional<Eigen::Vector2d>& little_mcp, const std::string& hand) {
   if (!wrist || !index_mcp || !little_mcp || (hand != "left" && hand != "right")) return Facing::kUnknown;

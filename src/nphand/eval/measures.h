@@ -1,11 +1,12 @@
 // Today's hand-pose measures (HO-3D, DexYCB, FreiHAND), on the 21 keypoints in metres:
 // MPJPE about the root, PA-MPJPE after a similarity Procrustes alignment, the fraction of
-// keypoints within a distance and the area under that curve, jitter; and, from 2D keypoints,
+// keypoints within a distance and the area under that curve, jitter, lag; and, from 2D keypoints,
 // which side of the hand faces the camera. The paper's own
 // measures (pose-vector error, keypoints about the wrist) are in pose_errors.h.
 #pragma once
 
 #include <array>
+#include <deque>
 #include <optional>
 #include <span>
 #include <string>
@@ -73,6 +74,26 @@ class RunJitter {
  private:
   double sum_ = 0.0;
   int count_ = 0;  // second differences
+};
+
+// An estimate's lag behind its truth: the shift of the truth, 0 to kMaxLag frames back, at
+// which the keypoints about the wrist (RootRelativeError) agree best on average, over every
+// frame with an estimate (a shift counts the frames that far from their sequence's start).
+// A smoother that trails the motion agrees best with an earlier truth.
+inline constexpr int kMaxLag = 8;
+class LagMeter {
+ public:
+  // The next frame of the sequence: its truth, and the estimate if there is one.
+  void Add(const Keypoints3d& truth, const Keypoints3d* estimate);
+  // Before another sequence's first frame.
+  void Restart() { truths_.clear(); }
+  // The best shift, in frames; none before any estimate.
+  std::optional<int> Lag() const;
+
+ private:
+  std::deque<Keypoints3d> truths_;  // the sequence's last kMaxLag + 1, the newest first
+  std::array<double, kMaxLag + 1> error_{};
+  std::array<int, kMaxLag + 1> count_{};
 };
 
 }  // namespace nphand

@@ -72,6 +72,7 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
   // their frame numbers: for jitter.
   std::vector<Keypoints3d> estimated, true_keypoints;
   std::vector<int> detected_frames;
+  LagMeter lag;
   for (size_t i = 0; i < poses.size(); ++i) {
     const nlohmann::json& p = poses[i];
     const nlohmann::json& t = truth[i];
@@ -80,6 +81,11 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
     NPHAND_THROW_CHECK(e.frame == Field<int>(t, "frame", truth_path, i), poses_path.string(), ": line ", i + 1,
                        " is frame ", e.frame, " but the truth's line is another frame");
     e.detected = Field<bool>(p, "detected", poses_path, i);
+    const Points3 th = Field<Points3>(t, "keypoints_3d_hand_m", truth_path, i);
+    NPHAND_THROW_CHECK(th.size() == kNumKeypoints, truth_path.string(), ": line ", i + 1, ": keypoints must be 21");
+    Keypoints3d truth_hand;
+    for (int k = 0; k < kNumKeypoints; ++k) truth_hand[k] = Eigen::Vector3d(th[k][0], th[k][1], th[k][2]);
+    if (!e.detected) lag.Add(truth_hand, nullptr);
     if (e.detected) {
       const auto true_angles = Field<std::map<std::string, double>>(t, "joint_angles_deg", truth_path, i);
       const auto angles = Field<std::map<std::string, double>>(p, "joint_angles_deg", poses_path, i);
@@ -99,20 +105,17 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
       }
       e.wrist_deg = RotationAngleDeg(a, b);
       const Points3 kh = Field<Points3>(p, "keypoints_3d_hand_m", poses_path, i);
-      const Points3 th = Field<Points3>(t, "keypoints_3d_hand_m", truth_path, i);
       const Points3 kc = Field<Points3>(p, "keypoints_3d_camera_m", poses_path, i);
       const Points3 tc = Field<Points3>(t, "keypoints_3d_camera_m", truth_path, i);
       const Points2 k2 = Field<Points2>(p, "keypoints_2d_px", poses_path, i);
       const Points2 t2 = Field<Points2>(t, "keypoints_2d_px", truth_path, i);
-      NPHAND_THROW_CHECK(kh.size() == kNumKeypoints && th.size() == kNumKeypoints && kc.size() == kNumKeypoints &&
+      NPHAND_THROW_CHECK(kh.size() == kNumKeypoints && kc.size() == kNumKeypoints &&
                              tc.size() == kNumKeypoints && k2.size() == kNumKeypoints && t2.size() == kNumKeypoints,
                          poses_path.string(), ": line ", i + 1, ": keypoints must be 21");
       const double scale = ChainLength(th) / std::max(ChainLength(kh), 1e-9);
-      Keypoints3d estimate, truth_hand;
-      for (int k = 0; k < kNumKeypoints; ++k) {
-        estimate[k] = scale * Eigen::Vector3d(kh[k][0], kh[k][1], kh[k][2]);
-        truth_hand[k] = Eigen::Vector3d(th[k][0], th[k][1], th[k][2]);
-      }
+      Keypoints3d estimate;
+      for (int k = 0; k < kNumKeypoints; ++k) estimate[k] = scale * Eigen::Vector3d(kh[k][0], kh[k][1], kh[k][2]);
+      lag.Add(truth_hand, &estimate);
       // Both sets hold the wrist at the origin: root-relative distances are the plain ones.
       const std::vector<double> d = RootRelativeDistances(estimate, truth_hand);
       distances.insert(distances.end(), d.begin(), d.end());
@@ -169,6 +172,7 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
     summary.jitter_mm = 1000.0 * jitter.mean();
     summary.truth_jitter_mm = 1000.0 * truth_jitter.mean();
   }
+  summary.lag_frames = lag.Lag();
   return summary;
 }
 
@@ -207,6 +211,7 @@ nlohmann::json ToJson(const PoseErrorSummary& summary) {
           {"auc_0_50", JsonNumber(summary.auc_0_50)},
           {"jitter_mm", JsonNumber(summary.jitter_mm)},
           {"truth_jitter_mm", JsonNumber(summary.truth_jitter_mm)},
+          {"lag_frames", summary.lag_frames.has_value() ? nlohmann::json(*summary.lag_frames) : nlohmann::json(nullptr)},
           {"palm_back_judged", summary.palm_back_judged},
           {"palm_back_right", summary.palm_back_right},
           {"per_frame", frames}};
@@ -223,6 +228,10 @@ std::string FormatTable(const PoseErrorSummary& summary) {
   out << "keypoints within 20 mm " << Figure(summary.within_20mm) << ", AUC 0-50 mm " << Figure(summary.auc_0_50) << "\n";
   out << "jitter " << Figure(summary.jitter_mm) << " mm/frame^2 (the truth's own " << Figure(summary.truth_jitter_mm)
       << "; over runs of three detected frames)\n";
+  out << "lag behind the truth "
+      << (summary.lag_frames.has_value() ? std::to_string(*summary.lag_frames) + (*summary.lag_frames == 1 ? " frame" : " frames")
+                                          : std::string("n/a"))
+      << " (the shift of the truth, 0-" << kMaxLag << " frames back, at which the keypoints about the wrist agree best)\n";
   out << "palm or back towards the camera right in " << summary.palm_back_right << " of " << summary.palm_back_judged
       << " judged detected frames (the others edge-on or without a side)\n";
   return out.str();

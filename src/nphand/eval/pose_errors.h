@@ -45,6 +45,8 @@ struct PoseErrorSummary {
   // detected frames in a row: the estimate's and the truth's own over the same frames.
   double jitter_mm = 0.0;
   double truth_jitter_mm = 0.0;
+  // The estimate's lag behind the truth, frames (LagMeter, measures.h); none with nothing detected.
+  std::optional<int> lag_frames;
   // Detected frames whose side towards the camera is judged, and those the estimate has right.
   int palm_back_judged = 0, palm_back_right = 0;
 };

@@ -34,6 +34,7 @@ nlohmann::json ToJson(const MethodScore& s) {
           {"wrist_deg", JsonNumber(s.wrist_deg)},
           {"jitter_mm", JsonNumber(s.jitter_mm)},
           {"truth_jitter_mm", JsonNumber(s.truth_jitter_mm)},
+          {"lag_frames", s.lag_frames.has_value() ? nlohmann::json(*s.lag_frames) : nlohmann::json(nullptr)},
           {"ms_median", JsonNumber(s.ms_median)},
           {"pose_error_normalised", JsonNumber(s.pose_error_norm)},
           {"keypoint_error_normalised", JsonNumber(s.keypoint_norm)}};
@@ -45,7 +46,7 @@ std::string FormatScores(const std::vector<MethodScore>& scores, const std::stri
       << std::setw(9) << "no-hand"
       << std::setw(8) << "pose" << std::setw(7) << "/NN" << std::setw(9) << "kp_mm" << std::setw(7) << "/NN" << std::setw(8)
       << "PA_mm" << std::setw(7) << "<20mm" << std::setw(7) << "AUC" << std::setw(7) << "px" << std::setw(8) << "wrist"
-      << std::setw(8) << "jitter" << std::setw(8) << "ms" << "\n";
+      << std::setw(8) << "jitter" << std::setw(5) << "lag" << std::setw(8) << "ms" << "\n";
   out << std::fixed;
   auto cell = [&](double v, int width, int precision) {
     if (std::isfinite(v)) {
@@ -69,6 +70,7 @@ std::string FormatScores(const std::vector<MethodScore>& scores, const std::stri
     cell(s.keypoint_px, 7, 1);
     cell(s.wrist_deg, 8, 1);
     cell(s.jitter_mm, 8, 2);
+    out << std::setw(5) << (s.lag_frames.has_value() ? std::to_string(*s.lag_frames) : "-");
     cell(s.ms_median, 8, 2);
     out << "\n";
   }

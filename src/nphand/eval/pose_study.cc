@@ -40,7 +40,9 @@ MethodScore Summarise(const std::string& method, const std::string& sequence, do
   double px = 0.0;
   int px_frames = 0;
   RunJitter jitter, truth_jitter;
+  LagMeter lag;
   for (const std::vector<FrameFigures>& frames : runs) {
+    lag.Restart();
     std::vector<Keypoints3d> run_estimate, run_truth;
     auto close_run = [&]() {
       jitter.Add(run_estimate);
@@ -51,6 +53,7 @@ MethodScore Summarise(const std::string& method, const std::string& sequence, do
     for (const FrameFigures& f : frames) {
       ++s.frames;
       ms.push_back(f.ms);
+      lag.Add(f.truth, f.detected ? &f.estimate : nullptr);
       if (!f.detected) {
         close_run();
         continue;
@@ -79,6 +82,7 @@ MethodScore Summarise(const std::string& method, const std::string& sequence, do
   s.auc_0_50 = AreaUnderCurve(s.distances, 0.050);
   s.jitter_mm = jitter.empty() ? kNaN : 1000.0 * jitter.mean();
   s.truth_jitter_mm = truth_jitter.empty() ? kNaN : 1000.0 * truth_jitter.mean();
+  s.lag_frames = lag.Lag();
   s.ms_median = Median(ms);
   for (const std::vector<bool>& found : no_hand) {
     s.no_hand_frames += static_cast<int>(found.size());
@@ -249,12 +253,12 @@ std::vector<MethodScore> RunMethods(std::vector<std::unique_ptr<PoseMethod>>& me
           FrameFigures f;
           f.ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
           f.detected = e.detected;
+          f.truth = frame.truth.keypoints;
           if (e.detected) {
             const HandPose& truth = frame.truth.pose;
             f.pose_error = (ToPoseVector(e.pose) - ToPoseVector(truth)).norm();
             f.estimate = e.keypoints_hand.has_value() ? *e.keypoints_hand : hand.KeypointsOf(e.pose);
             for (Eigen::Vector3d& k : f.estimate) k *= frame.hand_length_m / model_length;
-            f.truth = frame.truth.keypoints;
             f.distances = RootRelativeDistances(f.estimate, f.truth);
             f.keypoint_mm = 1000.0 * RootRelativeError(f.estimate, f.truth);
             f.pa_mpjpe_mm = 1000.0 * ProcrustesError(f.estimate, f.truth);

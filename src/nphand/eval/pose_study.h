@@ -94,6 +94,7 @@ struct MethodScore {
   double auc_0_50 = 0.0;
   double jitter_mm = 0.0;          // mm per frame squared, over runs of detected frames
   double truth_jitter_mm = 0.0;    // the truth's over the same frames
+  std::optional<int> lag_frames;   // behind the truth (LagMeter, measures.h); none with nothing detected
   double ms_median = 0.0;          // per frame
   // Divided by the NN-pose bound's on the same frames (Fig. 6's normalisation); NaN without it.
   double pose_error_norm = 0.0;
