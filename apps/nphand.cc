@@ -243,8 +243,8 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
       ->capture_default_str();
   AddRefineMoveOption(cmd, o.refine_move);
   cmd->add_flag("--smooth,!--no-smooth", e.smooth, "Smooth the track's poses over time (a One Euro filter)")->capture_default_str();
-  cmd->add_option("--smooth-cutoff", e.smoothing.min_cutoff_hz, "Smoothing: the cutoff of a still hand, Hz")->capture_default_str();
-  cmd->add_option("--smooth-beta", e.smoothing.beta, "Smoothing: the cutoff's rise with the hand's speed")->capture_default_str();
+  cmd->add_option("--smooth-cutoff", e.smoothing.min_cutoff_hz, "Smoothing: the cutoff of a still hand, Hz (the rotation has its own)")->capture_default_str();
+  cmd->add_option("--smooth-beta", e.smoothing.beta, "Smoothing: the cutoff's rise with the hand's speed (not the rotation's)")->capture_default_str();
   cmd->add_option("--smooth-rotation-cutoff", e.rotation_smoothing.min_cutoff_hz, "Smoothing: the cutoff of a still wrist's rotation, Hz")
       ->capture_default_str();
   cmd->add_option("--smooth-rotation-trend", e.rotation_smoothing.trend,

@@ -1130,7 +1130,7 @@ TEST_F(EstimatorTest, BadSetUpsAreRefused) {
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "least share of the hand found last");
   options = Options();
   options.rotation_smoothing.trend = -0.1;
-  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "smoothing's trend must be within [0, 1]");
+  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "the rotation's filter: the smoothing's trend must be within [0, 1]");
   testing::ExpectError([&] { Estimator(*db_, *index_, testing::LeftHand(), Options()); }, "right hand model");
   // An index of another descriptor.
   IndexedSet other = DatabaseDescriptors(*db_);

@@ -110,6 +110,15 @@ TEST_F(PoseErrorsTest, ACopyAFrameLateLagsByOne) {
   EXPECT_EQ(s.lag_frames, 1);
   EXPECT_EQ(ToJson(s)["lag_frames"], 1);
   EXPECT_NE(FormatTable(s).find("lag behind the truth 1 frame ("), std::string::npos) << FormatTable(s);
+  // Across a gap in the frame numbers the truth before the gap is not one frame back.
+  std::vector<nlohmann::json> gapped_truth, gapped;
+  for (int i = 0; i < 8; ++i) {
+    const int f = i < 4 ? i : i + 6;
+    gapped_truth.push_back(Line(f, true, hands_[i]));
+    gapped.push_back(Line(f, i == 4, hands_[3]));
+  }
+  const PoseErrorSummary g = ComparePoses(Write(dir / "gapped_truth.jsonl", gapped_truth), Write(dir / "gapped.jsonl", gapped));
+  EXPECT_EQ(g.lag_frames, 0);
 }
 
 TEST_F(PoseErrorsTest, APartRunOrAnotherSequenceIsRefused) {

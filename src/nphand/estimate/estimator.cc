@@ -210,8 +210,10 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the arm's agreement must be within [0, 100]";
   } else if (learn_interval < 1) {
     *why = "the learning interval must be at least 1 frame";
-  } else if (!skin.Check(why) || !forearm.Check(why) || !refinement.Check(why) || !smoothing.Check(why) ||
-             !rotation_smoothing.Check(why)) {
+  } else if (!skin.Check(why) || !forearm.Check(why) || !refinement.Check(why) || !smoothing.Check(why)) {
+    return false;
+  } else if (!rotation_smoothing.Check(why)) {
+    *why = "the rotation's filter: " + *why;
     return false;
   } else {
     return true;
@@ -272,11 +274,23 @@ double CandidateScore(const SkinRegion& region, cv::Size frame, cv::Rect last_bo
   return score;
 }
 
+namespace {
+
+// `options` once checked: before the members made from them, so that a bad setting is
+// named as the estimator's.
+const EstimatorOptions& Checked(const EstimatorOptions& options) {
+  std::string why;
+  NPHAND_THROW_CHECK(options.Check(&why), "estimator: ", why);
+  return options;
+}
+
+}  // namespace
+
 Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel& hand, const EstimatorOptions& options)
     : db_(db),
       index_(index),
       hand_(hand),
-      options_(options),
+      options_(Checked(options)),
       segmenter_(options.skin),
       renderer_(hand),
       smooth_wrist_(options.smoothing),
@@ -284,8 +298,6 @@ Estimator::Estimator(const Database& db, const KnnIndex& index, const HandModel&
       smooth_angles_(options.smoothing),
       smooth_rotation_(options.rotation_smoothing),
       side_(options.hand) {
-  std::string why;
-  NPHAND_THROW_CHECK(options.Check(&why), "estimator: ", why);
   NPHAND_THROW_CHECK(db.header().value("hand", "") == "right" && hand.handedness() == Handedness::kRight,
                      "estimator: needs a right-hand database and the right hand model (left hands are mirrored)");
   NPHAND_THROW_CHECK(db.header().value("hand_asset_sha256", "") == PinnedAssetSha256(Handedness::kRight),

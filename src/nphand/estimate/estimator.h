@@ -133,10 +133,10 @@ struct EstimatorOptions {
   bool refine_both_turns = true;
   // The track's estimates smoothed over time (estimate/smoother.h): the joint angles, the
   // rotation, the wrist's place and the image keypoints, each frame's pulled towards the
-  // last's by a One Euro filter; the 3D keypoints are the smoothed pose's. The rotation has
-  // a filter of its own: a track's steps from view to view are mostly the wrist's turns, and
-  // a lower cutoff with a trend steadies them without lag (the validation sweep's choice,
-  // docs/estimator.md).
+  // last's by a One Euro filter; the 3D keypoints are the smoothed pose's. `smoothing` is
+  // every group's but the rotation's, which has a filter of its own: a track's steps from
+  // view to view are mostly the wrist's turns, and a lower cutoff with a trend steadies them
+  // with no more lag than the others' (the validation sweep's choice, docs/estimator.md).
   bool smooth = true;
   SmoothOptions smoothing;
   SmoothOptions rotation_smoothing = {.min_cutoff_hz = 2.0, .beta = 0.5, .derivative_cutoff_hz = 0.5, .trend = 0.5};

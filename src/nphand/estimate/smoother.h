@@ -3,8 +3,9 @@
 // still hand stops shaking and a moving one does not lag. Each group of numbers (the
 // keypoints about the wrist, in the camera, in the image; the joint angles; the wrist's
 // quaternion) is filtered with one cutoff, from the group's speed in its own scale. With a
-// trend, each value is first predicted from the filter's smoothed rate (Holt's double
-// exponential smoothing): a steady motion is then followed without lag at a lower cutoff.
+// trend, each value is first predicted from the filter's smoothed rate (after Holt's double
+// exponential smoothing): a steady motion is then followed with less lag at a lower cutoff,
+// none with the whole trend, at the price of an overshoot after a step.
 #pragma once
 
 #include <optional>
@@ -22,7 +23,9 @@ struct SmoothOptions {
   // How far each value is predicted from the last by the smoothed rate before the new one
   // is weighed in: 0 (the One Euro filter as published) to 1 (the whole rate). On a ramp
   // the filter lags by (1 - a)(1 - trend) / (a + (1 - a) trend) frames' motion, a the new
-  // value's weight: 0 with trend 1.
+  // value's weight: 0 with trend 1 (the rate is measured against the last filtered value,
+  // so it holds the lag too). A step is overshot: at 2 Hz with trend 0.5 and beta 0, by 13 %
+  // eight frames after it at 30 frames/s, gone after about 20.
   double trend = 0.0;
   bool Check(std::string* why) const;
 };

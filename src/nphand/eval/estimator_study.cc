@@ -307,7 +307,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     }
     close_run();
     score.jitter_mm = 1000.0 * jitter.mean();
-    score.lag_frames = lag.Lag().value_or(0);
+    score.lag_frames = lag.Lag();
     score.ms_median = Median(ms);
     scores.push_back(score);
     line.Update(scores.size());
@@ -332,7 +332,7 @@ nlohmann::json ToJson(const std::vector<EstimatorScore>& scores) {
                     {"keypoint_px", s.keypoint_px},
                     {"camera_mm", s.camera_mm},
                     {"jitter_mm", s.jitter_mm},
-                    {"lag_frames", s.lag_frames},
+                    {"lag_frames", s.lag_frames.has_value() ? nlohmann::json(*s.lag_frames) : nlohmann::json(nullptr)},
                     {"ms_median", s.ms_median}});
   }
   return rows;
@@ -350,7 +350,7 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
         << s.joint_deg << std::setw(10) << s.wrist_deg << std::setprecision(1) << std::setw(12) << s.keypoint_mm
         << std::setw(12) << s.keypoint_px << std::setw(11) << s.camera_mm << std::setw(8) << s.jitter_mm
         << std::setprecision(2) << std::setw(8) << s.ms_median << std::setprecision(0) << std::setw(7)
-        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%" << std::setw(8) << s.turned << std::setw(8) << s.flipped << std::setw(5) << s.lag_frames << "\n";
+        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%" << std::setw(8) << s.turned << std::setw(8) << s.flipped << std::setw(5) << (s.lag_frames.has_value() ? std::to_string(*s.lag_frames) : "-") << "\n";
   }
   return out.str();
 }

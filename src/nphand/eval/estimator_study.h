@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -63,8 +64,8 @@ struct EstimatorScore {
   double keypoint_px = 0.0;    // mean 2D keypoint error in the frame
   double camera_mm = 0.0;      // mean 3D keypoint error in the camera frame (includes the distance)
   double jitter_mm = 0.0;      // keypoints about the wrist: mean second difference over runs of detected frames (mm/frame²)
-  // The estimate's lag behind the truth (LagMeter, measures.h; 0 with nothing detected).
-  int lag_frames = 0;
+  // The estimate's lag behind the truth (LagMeter, measures.h); none with nothing detected.
+  std::optional<int> lag_frames;
   double ms_median = 0.0;      // per frame, the whole estimator
 };
 

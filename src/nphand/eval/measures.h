@@ -78,7 +78,7 @@ class RunJitter {
 
 // An estimate's lag behind its truth: the shift of the truth, 0 to kMaxLag frames back, at
 // which the keypoints about the wrist (RootRelativeError) agree best on average, over every
-// frame with an estimate (a shift counts the frames that far from their sequence's start).
+// frame with an estimate (shift s counts only the frames at least s into their sequence).
 // A smoother that trails the motion agrees best with an earlier truth.
 inline constexpr int kMaxLag = 8;
 class LagMeter {

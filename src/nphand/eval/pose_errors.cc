@@ -85,7 +85,8 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
     NPHAND_THROW_CHECK(th.size() == kNumKeypoints, truth_path.string(), ": line ", i + 1, ": keypoints must be 21");
     Keypoints3d truth_hand;
     for (int k = 0; k < kNumKeypoints; ++k) truth_hand[k] = Eigen::Vector3d(th[k][0], th[k][1], th[k][2]);
-    if (!e.detected) lag.Add(truth_hand, nullptr);
+    // The lag reaches back over consecutive frames only, as the jitter does.
+    if (i > 0 && int64_t{e.frame} != int64_t{summary.frames.back().frame} + 1) lag.Restart();
     if (e.detected) {
       const auto true_angles = Field<std::map<std::string, double>>(t, "joint_angles_deg", truth_path, i);
       const auto angles = Field<std::map<std::string, double>>(p, "joint_angles_deg", poses_path, i);
@@ -146,6 +147,8 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
       const std::array<double, kMeasures.size()> row = {e.joint_deg,   e.wrist_deg, e.keypoint_mm,
                                                         e.keypoint_px, e.camera_mm, e.pa_mpjpe_mm};
       for (size_t m = 0; m < row.size(); ++m) values[m].push_back(row[m]);
+    } else {
+      lag.Add(truth_hand, nullptr);
     }
     summary.frames.push_back(e);
   }
