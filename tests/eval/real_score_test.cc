@@ -251,6 +251,35 @@ TEST(RealScoreTest, WhichSideFacesTheCameraFollowsTheTurnAndTheHandsSide) {
   EXPECT_NE(FormatTable(score).find("2/3"), std::string::npos);
 }
 
+// Steadiness on video: a hand whose labels move steadily and whose estimate shakes 3 px up
+// and down about them; a frame off its hand ends the run of found frames.
+TEST(RealScoreTest, AVideosJitterIsMeasuredOverRunsOfFoundFramesBesideTheLabels) {
+  const auto dir = testing::ScratchDir();
+  std::vector<nlohmann::json> labels_lines, prediction_lines;
+  for (int t = 0; t < 7; ++t) {
+    const nlohmann::json label = Keypoints(100 + 10 * t, 100);
+    labels_lines.push_back({{"file", "videos/asl_hand.mp4"}, {"frame", t}, {"hand", "right"}, {"keypoints_2d_px", label}});
+    const nlohmann::json estimate = t == 5 ? Shifted(label, 900, 0) : Shifted(label, 0, t % 2 == 0 ? 3.0 : -3.0);
+    prediction_lines.push_back({{"file", "videos/asl_hand.mp4"}, {"frame", t}, {"hands", {{{"keypoints_2d_px", estimate}}}}});
+  }
+  Write(dir / "labels.jsonl", labels_lines);
+  Write(dir / "predictions.jsonl", prediction_lines);
+  const std::vector<RealLabel> labels = ReadRealLabels(dir / "labels.jsonl");
+  const RealScore score = ScoreReal(labels, ReadRealPredictions(dir / "predictions.jsonl", labels));
+  ASSERT_EQ(score.videos.size(), 1u);
+  const RealSteadiness& s = score.videos[0];
+  EXPECT_EQ(s.file, "videos/asl_hand.mp4");
+  EXPECT_EQ(s.hand, "right");
+  EXPECT_EQ(s.frames, 7);
+  EXPECT_EQ(s.second_differences, 3) << "centred on frames 1-3: frame 5 was not found";
+  // |3 - 2 (-3) + 3| = 12 px, over the box's diagonal.
+  EXPECT_NEAR(*s.jitter, 12.0 / std::hypot(100.0, 100.0), 1e-12);
+  EXPECT_NEAR(*s.label_jitter, 0.0, 1e-12);
+  EXPECT_NEAR(ToJson(score)["videos"][0]["jitter_diag"].get<double>(), *s.jitter, 1e-12);
+  EXPECT_NE(FormatTable(score).find("steadiness, videos/asl_hand.mp4 (right): 2D jitter 0.0849"), std::string::npos)
+      << FormatTable(score);
+}
+
 TEST(RealScoreTest, MalformedLabelsAndPredictionsAreRefusedByLine) {
   const auto dir = testing::ScratchDir();
   const nlohmann::json good = {{"file", "images/freihand_1.jpg"}, {"hand", "right"}, {"keypoints_2d_px", Keypoints(0, 0)}};

@@ -427,6 +427,7 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
       } else {
         const PredictedHand& hand = hands[assign[i]];
         r.centroid = Centroid(hand.keypoints_2d);
+        r.keypoints_2d = hand.keypoints_2d;
         if (!hand.hand.empty()) r.handedness_ok = hand.hand == label.hand;
         if (!label.labelled.empty()) {
           std::vector<double> e;
@@ -478,6 +479,42 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
   score.gt_all = aggregate(gt, false);
   score.gt_one_hand = aggregate([&](const RealHandScore& r) { return gt(r) && r.hands_in_image == 1; }, true);
   score.gt_two_hand = aggregate([&](const RealHandScore& r) { return gt(r) && r.hands_in_image >= 2; }, true);
+  // Each video's steadiness, by side, in frame order.
+  std::map<std::pair<std::string, std::string>, std::vector<const RealHandScore*>> tracks;
+  for (const RealHandScore& r : score.hands) {
+    if (r.label->frame.has_value()) tracks[{r.label->file, r.label->hand}].push_back(&r);
+  }
+  for (auto& [key, rows] : tracks) {
+    std::stable_sort(rows.begin(), rows.end(), [](const RealHandScore* a, const RealHandScore* b) { return *a->label->frame < *b->label->frame; });
+    RealSteadiness s;
+    s.file = key.first;
+    s.hand = key.second;
+    s.frames = static_cast<int>(rows.size());
+    double jitter = 0.0, label_jitter = 0.0;
+    for (size_t t = 1; t + 1 < rows.size(); ++t) {
+      const RealHandScore &a = *rows[t - 1], &b = *rows[t], &c = *rows[t + 1];
+      if (!a.found || !b.found || !c.found || *a.label->frame + 1 != *b.label->frame || *b.label->frame + 1 != *c.label->frame) {
+        continue;
+      }
+      double sum = 0.0, label_sum = 0.0;
+      int n = 0;
+      for (int k = 0; k < kNumKeypoints; ++k) {
+        if (!a.label->keypoints_2d[k] || !b.label->keypoints_2d[k] || !c.label->keypoints_2d[k]) continue;
+        sum += ((*c.keypoints_2d)[k] - 2.0 * (*b.keypoints_2d)[k] + (*a.keypoints_2d)[k]).norm();
+        label_sum += (*c.label->keypoints_2d[k] - 2.0 * *b.label->keypoints_2d[k] + *a.label->keypoints_2d[k]).norm();
+        ++n;
+      }
+      if (n == 0) continue;
+      jitter += sum / n / b.label->diag;
+      label_jitter += label_sum / n / b.label->diag;
+      ++s.second_differences;
+    }
+    if (s.second_differences > 0) {
+      s.jitter = jitter / s.second_differences;
+      s.label_jitter = label_jitter / s.second_differences;
+    }
+    score.videos.push_back(s);
+  }
   std::vector<double> stills, video;
   for (const RealPrediction& p : predictions) {
     if (p.ms.has_value()) (p.frame.has_value() ? video : stills).push_back(*p.ms);
@@ -522,11 +559,21 @@ nlohmann::json ToJson(const RealScore& score) {
     }
     hands.push_back(h);
   }
+  nlohmann::json videos = nlohmann::json::array();
+  for (const RealSteadiness& s : score.videos) {
+    videos.push_back({{"file", s.file},
+                      {"hand", s.hand},
+                      {"frames", s.frames},
+                      {"second_differences", s.second_differences},
+                      {"jitter_diag", Optional(s.jitter)},
+                      {"label_jitter_diag", Optional(s.label_jitter)}});
+  }
   return {{"per_source", per_source},
           {"overall",
            {{"gt_all", ToJson(score.gt_all)},
             {"gt_one_hand_images", ToJson(score.gt_one_hand)},
             {"gt_two_hand_images", ToJson(score.gt_two_hand)}}},
+          {"videos", videos},
           {"timing", {{"stills_median_ms", Optional(score.stills_median_ms)}, {"video_median_ms", Optional(score.video_median_ms)}}},
           {"per_hand", hands}};
 }
@@ -581,6 +628,11 @@ std::string FormatTable(const RealScore& score) {
       separator = ", ";
     }
     out << "\n";
+  }
+  for (const RealSteadiness& s : score.videos) {
+    out << "steadiness, " << s.file << " (" << s.hand << "): 2D jitter " << figure(s.jitter, 4)
+        << " of the hand box's diagonal per frame^2, the labels' own " << figure(s.label_jitter, 4) << " (" << s.second_differences
+        << " second differences over runs of found frames, of " << s.frames << " frames)\n";
   }
   out << "timing: stills median " << figure(score.stills_median_ms, 1) << " ms, video frames median "
       << figure(score.video_median_ms, 1) << " ms\n";

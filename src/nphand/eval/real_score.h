@@ -22,6 +22,11 @@
 //    fingers are plain (RealGestureFingers: "peace" has the index and middle finger straight,
 //    the ring and little finger curled), the prediction's 3D finger states against them,
 //    agreement out of 4 per hand;
+//  - steadiness on video (nphand's own measure): per video and labelled side, over each run
+//    of consecutive frames whose hand was found, the mean second difference of the 2D
+//    keypoints (|k(t+1) - 2 k(t) + k(t-1)|, over keypoints labelled in all three frames)
+//    divided by the labelled box's diagonal at t; beside it the labels' own, over the same
+//    frames (for MediaPipe's reference landmarks, MediaPipe's jitter);
 //  - palm or back towards the camera (nphand's own measure; the reference has none): from
 //    the 2D keypoints and the hand's side, the sense of the turn from the wrist->index MCP
 //    ray to the wrist->little MCP ray; a right hand whose palm faces the camera turns
@@ -124,6 +129,7 @@ struct RealHandScore {
   std::optional<int> gesture_finger_agree;  // of 4: found hands whose label's gesture fixes its fingers
   std::optional<bool> facing_ok;      // found hands whose label's facing is judged
   std::optional<Eigen::Vector2d> centroid;  // the partner's keypoint centroid
+  std::optional<std::array<Eigen::Vector2d, kNumKeypoints>> keypoints_2d;  // the partner's
   // A hand not found: why. The status of the estimate that looked for its side and found
   // nothing (RealPrediction::missed: "no_skin", "not_a_hand"), else "elsewhere" (hands were
   // estimated, all off it), "not_run", or "no_hand" (a prediction without hands that says
@@ -145,8 +151,18 @@ struct RealAggregate {
   std::optional<double> found_rate() const { return hands > 0 ? std::optional<double>(double(found) / hands) : std::nullopt; }
 };
 
+// A video's steadiness (one labelled side): jitter of the found hand's 2D keypoints and of
+// the labels' own over the same frames, in label-box diagonals per frame squared.
+struct RealSteadiness {
+  std::string file, hand;
+  int frames = 0;                    // labelled frames of this side
+  int second_differences = 0;        // centred on frames whose neighbours were found too
+  std::optional<double> jitter, label_jitter;
+};
+
 struct RealScore {
   std::vector<RealHandScore> hands;                  // in label order within each image
+  std::vector<RealSteadiness> videos;                // by file and side
   std::vector<std::pair<std::string, int>> extras;   // (file, frame) of each extra predicted hand
   std::map<std::string, RealAggregate> per_source;
   RealAggregate gt_all, gt_one_hand, gt_two_hand;
