@@ -485,7 +485,8 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
     if (r.label->frame.has_value()) tracks[{r.label->file, r.label->hand}].push_back(&r);
   }
   for (auto& [key, rows] : tracks) {
-    std::stable_sort(rows.begin(), rows.end(), [](const RealHandScore* a, const RealHandScore* b) { return *a->label->frame < *b->label->frame; });
+    std::stable_sort(rows.begin(), rows.end(),
+                     [](const RealHandScore* a, const RealHandScore* b) { return *a->label->frame < *b->label->frame; });
     RealSteadiness s;
     s.file = key.first;
     s.hand = key.second;
