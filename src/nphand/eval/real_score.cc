@@ -426,7 +426,6 @@ RealScore ScoreReal(const std::vector<RealLabel>& labels, const std::vector<Real
         }
       } else {
         const PredictedHand& hand = hands[assign[i]];
-        r.centroid = Centroid(hand.keypoints_2d);
         r.keypoints_2d = hand.keypoints_2d;
         if (!hand.hand.empty()) r.handedness_ok = hand.hand == label.hand;
         if (!label.labelled.empty()) {
@@ -542,7 +541,8 @@ nlohmann::json ToJson(const RealScore& score) {
       h["miss"] = r.miss;
       if (!r.miss_reason.empty()) h["miss_reason"] = r.miss_reason;
     } else {
-      h["pred_centroid"] = {r.centroid->x(), r.centroid->y()};
+      const Eigen::Vector2d centroid = Centroid(*r.keypoints_2d);
+      h["pred_centroid"] = {centroid.x(), centroid.y()};
       h["handedness_ok"] = r.handedness_ok.has_value() ? nlohmann::json(*r.handedness_ok) : nlohmann::json(nullptr);
       if (r.mean_norm_err.has_value()) {
         h["mean_norm_err"] = *r.mean_norm_err;

@@ -128,7 +128,6 @@ struct RealHandScore {
   std::optional<int> finger_agree;    // of 4
   std::optional<int> gesture_finger_agree;  // of 4: found hands whose label's gesture fixes its fingers
   std::optional<bool> facing_ok;      // found hands whose label's facing is judged
-  std::optional<Eigen::Vector2d> centroid;  // the partner's keypoint centroid
   std::optional<std::array<Eigen::Vector2d, kNumKeypoints>> keypoints_2d;  // the partner's
   // A hand not found: why. The status of the estimate that looked for its side and found
   // nothing (RealPrediction::missed: "no_skin", "not_a_hand"), else "elsewhere" (hands were
