@@ -215,6 +215,9 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
       ->check(WholeNumber())
       ->capture_default_str();
   cmd->add_option("--top-n", e.top_n, "Hypotheses kept per frame")->capture_default_str();
+  cmd->add_option("--mode-mean", e.mode_mean,
+                  "The estimate: the weighted mean of the hypotheses within this pose distance of the best (0: the best alone)")
+      ->capture_default_str();
   cmd->add_flag("--top", o.top, "Write the top-N hypotheses in each line");
   cmd->add_option("--max-distance", e.max_distance, "No hand when the nearest view is farther than this")->capture_default_str();
   cmd->add_option("--max-elongation", e.max_elongation, "No hand when the silhouette's principal axes differ more than this ratio")

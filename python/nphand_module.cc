@@ -325,6 +325,7 @@ PYBIND11_MODULE(nphand, m) {
       .def_property_readonly("box", [](const FrameResult& r) { return py::make_tuple(r.box.x, r.box.y, r.box.width, r.box.height); })
       .def_readonly("depth_m", &FrameResult::depth_m)
       .def_readonly("confidence", &FrameResult::confidence)
+      .def_readonly("mean_of", &FrameResult::mean_of, "hypotheses averaged into the estimate (1: the best alone)")
       .def_readonly("refined", &FrameResult::refined, "with refine: whether the refinement moved the pose")
       .def_property_readonly(
           "proportions",

@@ -84,7 +84,7 @@ TEST_F(EstimateCommandTest, AFolderGivesOneLinePerFrameWithEveryFieldAndAnOverla
     ++detected;
     for (const char* key : {"hand", "wrist_rotation", "wrist_quaternion_wxyz", "joint_angles_deg", "pose_vector",
                             "keypoints_2d_px", "keypoints_3d_hand_m", "keypoints_3d_camera_m", "depth_m", "box_px",
-                            "grasps", "objects", "confidence", "effective_samples", "nearest_distance", "top"}) {
+                            "grasps", "objects", "confidence", "effective_samples", "mean_of", "nearest_distance", "top"}) {
       EXPECT_TRUE(line.contains(key)) << key;
     }
     EXPECT_EQ(line["keypoints_2d_px"].size(), 21u);

@@ -39,6 +39,8 @@ TEST_F(EstimatorStudyTest, EverySettingIsNamedOnceAndVariesWhatItSays) {
   };
   EXPECT_EQ(find("nn").options.prior, PriorCombination::kNone);
   EXPECT_EQ(find("turns0").options.roll_ambiguity, 0.0);
+  EXPECT_EQ(find("mode-mean0").options.mode_mean, 0.0);
+  EXPECT_EQ(find("mode-mean2").options.mode_mean, 2.0);
   EXPECT_EQ(find("k50").options.k, 50);
   EXPECT_EQ(find("k250").options.k, 250);
   EXPECT_EQ(find("k2000").options.k, 2000);
@@ -114,6 +116,7 @@ TEST_F(EstimatorStudyTest, RunsTheNamedSettingsOverTheSequences) {
   EXPECT_EQ(scores[1].name, "turns0");
   EXPECT_EQ(scores[1].both_turns, 0) << "never the half turn";
   EXPECT_EQ(scores[1].options["roll_ambiguity"], 0.0);
+  EXPECT_EQ(scores[1].options["mode_mean"], EstimatorOptions{}.mode_mean);
   EXPECT_GE(scores[2].both_turns, scores[1].both_turns);
   const nlohmann::json json = ToJson(scores);
   EXPECT_EQ(json.size(), 3u);

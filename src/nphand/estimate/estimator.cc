@@ -192,6 +192,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the frames carrying hypotheses apart must be 0 or more";
   } else if (carried < 1 || carried > k || top_n < 1 || top_n > k) {
     *why = "carried hypotheses and top-N must be within 1..k";
+  } else if (!(mode_mean >= 0.0 && mode_mean < 10.0)) {
+    *why = "the mode's mean must reach within [0, 10) of the best hypothesis";
   } else if (!(roll_ambiguity >= 0.0 && roll_ambiguity < 10.0) || !(max_distance > 0.0 && max_distance < 10.0)) {
     *why = "roll ambiguity must be within [0, 10) and the largest distance within (0, 10)";
   } else if (!(focal_px >= 0.0 && focal_px < 1e6) || !(fov_deg > 1.0 && fov_deg < 179.0)) {
@@ -695,6 +697,16 @@ struct Candidate {
   double w = 0.0;
 };
 
+// `entry`, the scene of the best hypothesis in its database view, with the hand posed as
+// `mean` (the mode's mean, in the frame's image plane: the best's `turn` undone puts it in
+// the view), its wrist placed as the database places it.
+Scene WithMean(Scene entry, const HandPose& mean, double turn, const Eigen::Vector3d& bind_centre, double distance) {
+  entry.hand.angles = mean.angles;
+  entry.hand.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), -turn) * mean.camera_from_hand;
+  entry.wrist_in_camera = CenteredWristPosition(entry.hand.camera_from_hand, bind_centre, distance);
+  return entry;
+}
+
 }  // namespace
 
 // A frame's region as it passes Estimate's stages.
@@ -707,6 +719,7 @@ struct Estimator::Lookup {
   std::vector<Candidate> hyp;
   std::vector<size_t> order;          // hyp by weight, best first
   const Candidate& best() const { return hyp[order[0]]; }
+  std::optional<HandPose> mean;       // with mode_mean: the mode's weighted mean (the frame's orientation)
 };
 
 bool Estimator::Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, Lookup* lookup, FrameResult* result) {
@@ -911,6 +924,31 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     result->top.push_back(out);
   }
   result->pose = result->top[0].pose;
+  if (options_.mode_mean > 0.0) {
+    // The mode's mean: the hypotheses near the best, each by its weight.
+    Eigen::Matrix3d rotation = Eigen::Matrix3d::Zero();
+    std::array<double, kNumDofs> angles{};
+    double sum = 0.0;
+    int count = 0;
+    for (const Candidate& h : hyp) {
+      if ((h.x - best.x).norm() >= options_.mode_mean) continue;
+      for (int r = 0; r < 3; ++r) {
+        for (int col = 0; col < 3; ++col) rotation(r, col) += h.w * h.x[3 * r + col];
+      }
+      const JointAngles a = AnglesOf(h.entry);
+      for (int j = 0; j < kNumDofs; ++j) angles[j] += h.w * a[j];
+      sum += h.w;
+      ++count;
+    }
+    if (count > 1 && sum > 0.0) {
+      HandPose mean;
+      mean.camera_from_hand = NearestRotation(rotation);
+      for (int j = 0; j < kNumDofs; ++j) mean.angles[j] = angles[j] / sum;
+      lookup->mean = mean;
+      result->pose = mean;
+      result->mean_of = count;
+    }
+  }
   result->ms.weigh = Ms(t, Clock::now());
   return true;
 }
@@ -920,8 +958,8 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
   *turn = best.turn;
   *crop = best.turn_of;
   if (!refiner_.has_value()) return std::nullopt;
-  // Refinement: the best entry's pose moved until its silhouette agrees with the query's;
-  // it then stands for the entry in what follows.
+  // Refinement: the best entry's pose (the mode's mean, where there is one) moved until its
+  // silhouette agrees with the query's; it then stands for the entry in what follows.
   const Clock::time_point t = Clock::now();
   // While the track holds (the prior took part), the side's refined rotation of the frame
   // before.
@@ -942,10 +980,13 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
       options_.refinement.move_proportions && !width_was_held && (!options_.hand_auto || result->hand == side_);
   auto attempt = [&](const Candidate& c) {
     const cv::Matx23d start_map = PlacementOf(c.entry).crop_from_image;
+    // The best starts from the mode's mean, where there is one.
+    Scene start = EntryScene(c.entry);
+    if (&c == &best && lookup.mean.has_value()) start = WithMean(start, *lookup.mean, c.turn, hand_.bind_centre(), db_distance_);
     // The track's last rotation in this entry's image plane.
     const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -c.turn) * before;
     Tried tried{&c,
-                refiner_->Refine(lookup.crops[c.turn_of], EntryScene(c.entry), start_map, track ? &previous : nullptr,
+                refiner_->Refine(lookup.crops[c.turn_of], start, start_map, track ? &previous : nullptr,
                                  held_width_.value_or(1.0), move_width),
                 0.0};
     if (last) tried.from_last = RotationAngleDeg(AxisAngle(Eigen::Vector3d::UnitZ(), c.turn) * RotationOf(tried.r), before);
@@ -966,6 +1007,7 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
   const Candidate& c = *chosen.start;
   const Refinement& r = chosen.r;
   result->refined = r.moved || &c != &best;
+  if (&c != &best) result->mean_of = 1;  // the other turn's best stands alone
   result->refine_objective = std::make_pair(r.objective_before, r.objective_after);
   if (options_.refinement.move_proportions) {
     // A frame's measurement counts if the silhouette of its start's pose at that width agrees
@@ -1050,8 +1092,15 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   // may turn it further, and its pose then stands for the best entry's.
   double turn = 0.0;
   int crop = 0;
-  const std::optional<EntryPlacement> refined = Refine(lookup, &turn, &crop, &result);
-  Place(lookup, crop, refined.has_value() ? *refined : PlacementOf(lookup.best().entry), turn, box, frame, &result);
+  std::optional<EntryPlacement> placed = Refine(lookup, &turn, &crop, &result);
+  if (!placed.has_value() && lookup.mean.has_value()) {
+    // The mode's mean, placed through the best's crop.
+    const Candidate& best = lookup.best();
+    const Scene scene = WithMean(EntryScene(best.entry), *lookup.mean, best.turn, hand_.bind_centre(), db_distance_);
+    placed = EntryPlacement{best.entry, 0, PlacementOf(best.entry).crop_from_image, hand_.KeypointsOf(scene.hand),
+                            scene.wrist_in_camera};
+  }
+  Place(lookup, crop, placed.has_value() ? *placed : PlacementOf(lookup.best().entry), turn, box, frame, &result);
   return result;
 }
 

@@ -68,6 +68,11 @@ struct EstimatorOptions {
   // (docs/estimator.md). 0: none.
   int track_views = 4;
   int top_n = 5;                                // hypotheses in each result
+  // The estimate: the weighted mean of the hypotheses within this distance of the best in
+  // pose (pose-vector units, as sigma_x; their rotations' chordal mean, their joint angles'
+  // mean), placed through the best's crop, so that it moves between the database's poses
+  // rather than stepping from one to the next (0: the best alone, as the paper).
+  double mode_mean = 1.0;
   // Search the half-turned crop too when the silhouette's skewness is below this (its two
   // ends look alike, so the principal axis's direction is a guess). The sweep's choice:
   // 0.05 searches twice in a quarter of the frames (0.15: 58 %), for 0.2 mm more error and
@@ -201,6 +206,8 @@ struct FrameResult {
   // With refine: whether the refinement moved the pose (or kept the other turn's best
   // entry), and the kept refinement's objective (silhouette disagreement, 1 - IoU, plus the
   // pulls towards the start and the last frame's rotation) before and after.
+  // Hypotheses averaged into the estimate (EstimatorOptions::mode_mean; 1: the best alone).
+  int mean_of = 1;
   bool refined = false;
   std::optional<std::pair<double, double>> refine_objective;
   // With refine measuring the proportions (RefineOptions::move_proportions): the hand's

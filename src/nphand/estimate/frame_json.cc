@@ -71,6 +71,7 @@ nlohmann::json FrameResultJson(const FrameResult& r, const Database& db, bool wi
   j["objects"] = Posterior(r.objects, "object");
   j["confidence"] = r.confidence;
   j["effective_samples"] = r.effective_samples;
+  j["mean_of"] = r.mean_of;
   j["nearest_distance"] = r.nearest_distance;
   j["forearm_cut"] = r.forearm_cut;
   j["both_turns"] = r.both_turns;

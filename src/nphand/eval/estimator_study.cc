@@ -60,6 +60,13 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
   for (int carried : {20, 100}) {
     around_default("carried" + std::to_string(carried), [&](EstimatorOptions& e) { e.carried = carried; });
   }
+  // The estimate as the mode's weighted mean: how far from the best its hypotheses may lie
+  // (0: the best alone).
+  for (double reach : {0.0, 0.25, 0.5, 1.0, 1.5, 2.0}) {
+    std::ostringstream name;
+    name << "mode-mean" << reach;
+    around_default(name.str(), [&](EstimatorOptions& e) { e.mode_mean = reach; });
+  }
   // How often the half-turned crop is searched too (its cost: a second descriptor and search).
   for (double ambiguity : {0.0, 0.15, 0.3}) {
     std::ostringstream name;
@@ -255,7 +262,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     score.options = {{"k", e.k},           {"observation", ToString(e.observation)}, {"sigma_y", e.sigma_y},
                      {"prior", ToString(e.prior)}, {"sigma_x", e.sigma_x}, {"prior_share", e.prior_share},
                      {"carried", e.carried},        {"carry_apart_frames", e.carry_apart_frames}, {"roll_ambiguity", e.roll_ambiguity},
-                     {"refine", RefinementJson(e)},
+                     {"mode_mean", e.mode_mean},       {"refine", RefinementJson(e)},
                      {"smooth", SmoothingJson(e)}};
     std::vector<double> ms;
     RunJitter jitter;

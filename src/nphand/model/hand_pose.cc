@@ -145,18 +145,22 @@ HandPose MirrorPose(const HandPose& pose) {
   return mirrored;
 }
 
+Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& m) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  return svd.matrixU() * d * svd.matrixV().transpose();
+}
+
 HandPose FromPoseVector(const PoseVector& vector, Handedness handedness) {
   NPHAND_THROW_CHECK(vector.allFinite(), "pose vector has non-finite values");
   Eigen::Matrix3d m;
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) m(r, c) = vector[3 * r + c];
   }
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
   HandPose pose;
   pose.handedness = handedness;
-  pose.camera_from_hand = svd.matrixU() * d * svd.matrixV().transpose();
+  pose.camera_from_hand = NearestRotation(m);
   for (int i = 0; i < kNumDofs; ++i) pose.angles[i] = std::asin(std::clamp(vector[9 + i], -1.0, 1.0));
   return pose;
 }

@@ -83,6 +83,9 @@ std::vector<std::string> NamedArticulations();
 inline constexpr int kPoseVectorSize = 9 + kNumDofs;
 using PoseVector = Eigen::Matrix<double, kPoseVectorSize, 1>;
 PoseVector ToPoseVector(const HandPose& pose);
+// The rotation nearest `m` in the Frobenius norm (its projection onto SO(3)): of a weighted
+// sum of rotations, their chordal mean.
+Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& m);
 // Inverse of ToPoseVector: the rotation is projected onto SO(3), each angle is the arcsine
 // of its (clamped) sine. Throws nphand::Error for non-finite values.
 HandPose FromPoseVector(const PoseVector& vector, Handedness handedness);
