@@ -146,6 +146,7 @@ TEST_F(PoseStudyTest, TheEstimatorBeatsTheBaselinesAndNearsTheBound) {
   methods.push_back(MakeRegressionMethod(*db_, MakeLinearRegressor(), 3000, 1, nullptr));
   methods.push_back(MakeRegressionMethod(*db_, MakeGaussianProcess(), 600, 1, nullptr));
   methods.push_back(MakeRegressionMethod(*db_, MakeRvm(), 300, 1, nullptr));
+  EXPECT_EQ(methods[0]->Describe()["mode_mean"], pnp.mode_mean);
   const std::vector<MethodScore> scores = RunMethods(methods, *sequences_, {0.0, 2.0}, RightHand(), 5, nullptr);
   ASSERT_EQ(scores.size(), methods.size() * 2 * (sequences_->size() + 1));
 

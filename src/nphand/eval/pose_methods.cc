@@ -109,7 +109,7 @@ class EstimatorMethod : public PoseMethod {
     const EstimatorOptions& o = estimator_.options();
     return {{"index", backend_},         {"k", o.k},           {"observation", ToString(o.observation)},
             {"sigma_y", o.sigma_y},      {"prior", ToString(o.prior)}, {"sigma_x", o.sigma_x},
-            {"carried", o.carried},      {"input", from_rgb_ ? "rgb" : "mask"},
+            {"carried", o.carried},      {"mode_mean", o.mode_mean},   {"input", from_rgb_ ? "rgb" : "mask"},
             {"refine", RefinementJson(o)},
             {"smooth", SmoothingJson(o)}};
   }
