@@ -346,7 +346,7 @@ PYBIND11_MODULE(nphand, m) {
   py::class_<Estimate>(m, "Estimator", "Hand poses frame by frame, with the temporal prior over a video")
       .def(py::init([](std::shared_ptr<Database> db, std::shared_ptr<KnnIndex> index, std::shared_ptr<HandModel> hand,
                        const std::string& side, int k, int track_views, bool refine, const std::vector<std::string>& refine_move,
-                       bool smooth, double hand_length, double fov, double focal, bool faces) {
+                       bool smooth, double hand_length, double fov, double focal, bool faces, double mode_mean) {
              EstimatorOptions options;
              SetHandChoice(side, &options);
              options.k = k;
@@ -358,6 +358,7 @@ PYBIND11_MODULE(nphand, m) {
              options.fov_deg = fov;
              options.focal_px = focal;
              if (!faces) options.skin.face_cascade.clear();
+             options.mode_mean = mode_mean;
              std::string why;
              NPHAND_THROW_CHECK(options.Check(&why), "estimator: ", why);
              return std::make_unique<Estimate>(std::move(db), std::move(index), std::move(hand), options);
@@ -366,7 +367,7 @@ PYBIND11_MODULE(nphand, m) {
            py::arg("track_views") = EstimatorOptions{}.track_views, py::arg("refine") = false,
            py::arg("refine_move") = RefineMoves(RefineOptions{}), py::arg("smooth") = true,
            py::arg("hand_length") = 0.18, py::arg("fov") = 60.0,
-           py::arg("focal") = 0.0, py::arg("faces") = true)
+           py::arg("focal") = 0.0, py::arg("faces") = true, py::arg("mode_mean") = EstimatorOptions{}.mode_mean)
       .def("process", &Estimate::Process, py::arg("frame"), py::arg("time_s") = py::none(), py::arg("roi") = py::none(),
            "Estimates the hand in the next frame (H x W x 3 uint8 BGR); time_s defaults to 1/30 s after the last; "
            "roi (x, y, width, height), e.g. from your own hand detector, confines the search to that box")

@@ -76,6 +76,22 @@ def test_smoothing_is_on_by_default_and_can_be_turned_off(hand, tiny, frames):
     assert max(steps[1:]) > 1e-6
 
 
+def test_the_estimate_is_the_modes_mean_unless_asked_for_the_best_alone(hand, tiny, frames):
+    db, index = tiny
+    mean = nphand.Estimator(db, index, hand, k=40, faces=False, smooth=False)
+    best = nphand.Estimator(db, index, hand, k=40, faces=False, smooth=False, mode_mean=0.0)
+    averaged = 0
+    for frame in frames:
+        a = mean.process(frame["rgb"], frame["time_s"])
+        b = best.process(frame["rgb"], frame["time_s"])
+        assert a.detected and b.detected
+        assert b.mean_of == 1
+        averaged += a.mean_of > 1
+    assert averaged > 0
+    with pytest.raises(nphand.Error, match="the mode's mean must reach within"):
+        nphand.Estimator(db, index, hand, mode_mean=-1.0)
+
+
 def test_the_refinement_says_what_it_did_and_measures_proportions_when_asked(hand, tiny, frames):
     db, index = tiny
     plain = nphand.Estimator(db, index, hand, k=40, faces=False)

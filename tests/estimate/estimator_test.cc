@@ -847,7 +847,7 @@ TEST_F(EstimatorTest, RefinementBringsViewsBetweenTheDatabasesCloser) {
   }
   // Measured (from the mode's mean, the default): wrist 12.5 -> 10.5 degrees, keypoints
   // 24.6 -> 22.8 mm (from the best alone, before the mean: 13.3 -> 9.8 and 24.6 -> 22.4).
-  EXPECT_LT(wrist[1], 0.88 * wrist[0]) << wrist[0] / frames << " -> " << wrist[1] / frames << " deg";
+  EXPECT_LT(wrist[1], 0.85 * wrist[0]) << wrist[0] / frames << " -> " << wrist[1] / frames << " deg";
   EXPECT_LT(keypoints[1], 0.95 * keypoints[0]) << keypoints[0] / frames << " -> " << keypoints[1] / frames << " mm";
 }
 
@@ -875,11 +875,22 @@ TEST_F(EstimatorTest, TheModesMeanLiesBetweenTheDatabasesViews) {
     EXPECT_TRUE(first.pose.camera_from_hand.isApprox(first.top[0].pose.camera_from_hand, 1e-9)) << i;
     EXPECT_EQ(first.pose.angles, first.top[0].pose.angles) << i;
     EXPECT_TRUE(second.pose.IsValid()) << i;
-    EXPECT_GE(second.mean_of, 1) << i;
-    averaged += second.mean_of > 1;
-    // The mean stays near its best: the reach 1 of the pose vector holds rotations within
-    // about 41 degrees of it.
-    EXPECT_LT(RotationAngleDeg(second.pose.camera_from_hand, second.top[0].pose.camera_from_hand), 42.0) << i;
+    // The lookup is the same: the mean changes the estimate, not the hypotheses carried.
+    ASSERT_EQ(first.top.size(), second.top.size()) << i;
+    for (size_t r = 0; r < first.top.size(); ++r) {
+      EXPECT_EQ(first.top[r].entry, second.top[r].entry) << i;
+      EXPECT_DOUBLE_EQ(first.top[r].weight, second.top[r].weight) << i;
+    }
+    // The keypoints are the estimate's pose (placed through the best's view, its turn undone
+    // and done again), for either estimate.
+    for (const FrameResult* r : {&first, &second}) {
+      const Keypoints3d posed = RightHand().KeypointsOf(r->pose);
+      for (int k = 0; k < kNumKeypoints; ++k) EXPECT_LT((r->keypoints_hand[k] - posed[k]).norm(), 1e-6) << i << " " << k;
+    }
+    const bool moved = RotationAngleDeg(second.pose.camera_from_hand, second.top[0].pose.camera_from_hand) > 0.01 ||
+                       second.pose.angles != second.top[0].pose.angles;
+    EXPECT_TRUE(!moved || second.mean_of > 1) << i << ": a mean that moved averaged more than the best";
+    averaged += moved;
     EXPECT_EQ(FrameResultJson(second, *db_, false)["mean_of"].get<int>(), second.mean_of);
     ++frames;
     AddErrors(first, frame, &wrist[0], &keypoints[0]);

@@ -719,7 +719,7 @@ struct Estimator::Lookup {
   std::vector<Candidate> hyp;
   std::vector<size_t> order;          // hyp by weight, best first
   const Candidate& best() const { return hyp[order[0]]; }
-  std::optional<HandPose> mean;       // with mode_mean: the mode's weighted mean (the frame's orientation)
+  std::optional<HandPose> mean;       // with mode_mean: the mode's weighted mean (the frame's image plane, before the ray)
 };
 
 bool Estimator::Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, Lookup* lookup, FrameResult* result) {
@@ -931,7 +931,7 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     double sum = 0.0;
     int count = 0;
     for (const Candidate& h : hyp) {
-      if ((h.x - best.x).norm() >= options_.mode_mean) continue;
+      if (h.w <= 0.0 || (h.x - best.x).norm() >= options_.mode_mean) continue;
       for (int r = 0; r < 3; ++r) {
         for (int col = 0; col < 3; ++col) rotation(r, col) += h.w * h.x[3 * r + col];
       }
@@ -940,7 +940,7 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
       sum += h.w;
       ++count;
     }
-    if (count > 1 && sum > 0.0) {
+    if (count > 1) {
       HandPose mean;
       mean.camera_from_hand = NearestRotation(rotation);
       for (int j = 0; j < kNumDofs; ++j) mean.angles[j] = angles[j] / sum;

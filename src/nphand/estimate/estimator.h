@@ -3,9 +3,10 @@
 // described by the database's descriptor (roll-normalised HOG), and its K nearest database
 // entries found; each neighbour becomes a hypothesis (its pose turned by the two rolls),
 // weighted by its feature distance (the observation) and by a kernel density over the
-// previous frame's weighted hypotheses (the temporal prior). The best hypothesis is the
-// estimate; the weighted set carries to the next frame. The result also places the hand:
-// 21 keypoints in the image, in 3D about the wrist and in the camera frame.
+// previous frame's weighted hypotheses (the temporal prior). The estimate is the weighted
+// mean of the hypotheses near the best (the paper's: the best alone); the weighted set
+// carries to the next frame. The result also places the hand: 21 keypoints in the image, in
+// 3D about the wrist and in the camera frame.
 #pragma once
 
 #include <array>
@@ -127,9 +128,9 @@ struct EstimatorOptions {
   // video, finger states 909 -> 927 of 1300; docs/estimator.md).
   bool objects = true;
   int learn_interval = 10;                      // frames between skin-colour updates from confident frames
-  // Refinement beyond the database (refine/refiner.h): the best hypothesis's pose moved
-  // until its silhouette agrees with the hand's; keypoints, angles and rotation then come
-  // from the refined pose.
+  // Refinement beyond the database (refine/refiner.h): the estimate (the mode's mean, or the
+  // best hypothesis alone) moved until its silhouette agrees with the hand's; keypoints,
+  // angles and rotation then come from the refined pose.
   bool refine = false;
   RefineOptions refinement;
   // Where both turns of the crop were searched (roll_ambiguity), the other turn's best
@@ -202,12 +203,13 @@ struct FrameResult {
   bool searched = false;                       // the region was looked up in the database
   double nearest_distance = 0.0;               // the best neighbour's feature distance (if searched)
   double effective_samples = 0.0;              // 1 / sum w^2 over the hypotheses
-  double confidence = 0.0;                     // the posterior mass near the estimate, 0..1
+  double confidence = 0.0;                     // the posterior mass near the best hypothesis, 0..1
+  // Hypotheses of positive weight averaged into the estimate (EstimatorOptions::mode_mean;
+  // 1: the best alone).
+  int mean_of = 1;
   // With refine: whether the refinement moved the pose (or kept the other turn's best
   // entry), and the kept refinement's objective (silhouette disagreement, 1 - IoU, plus the
   // pulls towards the start and the last frame's rotation) before and after.
-  // Hypotheses averaged into the estimate (EstimatorOptions::mode_mean; 1: the best alone).
-  int mean_of = 1;
   bool refined = false;
   std::optional<std::pair<double, double>> refine_objective;
   // With refine measuring the proportions (RefineOptions::move_proportions): the hand's
@@ -312,13 +314,14 @@ class Estimator {
   // Hypotheses, observation weights, the prior, the carried hypotheses, the posteriors and
   // the top-N; false (with the reason) when nothing in the database is near.
   bool Weigh(cv::Rect box, Lookup* lookup, FrameResult* result);
-  // With refine: the best entry's pose (or, with refine_both_turns, the other turn's best
-  // entry's) refined against its crop: the placement, the turn and which crop it was
-  // refined against, or nothing (the best entry as it is, its turn and crop).
+  // With refine: the estimate's pose (the mode's mean, or the best entry's; with
+  // refine_both_turns perhaps the other turn's best entry's) refined against its crop: the
+  // placement, the turn and which crop it was refined against, or nothing (the estimate as
+  // the lookup made it, the best's turn and crop).
   struct EntryPlacement;
   std::optional<EntryPlacement> Refine(const Lookup& lookup, double* turn, int* crop, FrameResult* result);
-  // Keypoints in the frame and in 3D, from `entry`'s render and the query's crop `crop`,
-  // turned by `turn`.
+  // Keypoints in the frame and in 3D, from `entry` (an entry's render, its pose the entry's
+  // own, the mode's mean or the refinement's) and the query's crop `crop`, turned by `turn`.
   void Place(const Lookup& lookup, int crop, const EntryPlacement& entry, double turn, cv::Rect box, cv::Size frame,
              FrameResult* result);
   // Estimate for a hand of side `side`: a left hand's mask is mirrored into the right-hand

@@ -364,12 +364,15 @@ PoseStudyResult RunPoseStudy(PoseStudyPart part, const Database& db, const KnnIn
   result.sequences = DescribeSequences(sequences);
 
   // The paper's PNP: each frame's estimate as it comes, unsmoothed (nphand's default,
-  // smoothed, has rows of its own).
+  // smoothed, has rows of its own), the estimate the mode's mean about the best (as
+  // nphand's default; the paper's is the best alone, `mode_mean` 0). NN feature is the
+  // paper's: the nearest neighbour in feature space, alone.
   EstimatorOptions pnp = options_base;
   pnp.hand_length_m = ModelHandLength(db);
   pnp.smooth = false;
   EstimatorOptions nn_feature = pnp;
   nn_feature.prior = PriorCombination::kNone;
+  nn_feature.mode_mean = 0.0;
   std::unique_ptr<KnnIndex> exact;
   std::vector<std::unique_ptr<PoseMethod>> methods;
   if (options.exact && part != PoseStudyPart::kRobustness) {
