@@ -697,16 +697,6 @@ struct Candidate {
   double w = 0.0;
 };
 
-// `entry`, the scene of the best hypothesis in its database view, with the hand posed as
-// `mean` (the mode's mean, in the frame's image plane: the best's `turn` undone puts it in
-// the view), its wrist placed as the database places it.
-Scene WithMean(Scene entry, const HandPose& mean, double turn, const Eigen::Vector3d& bind_centre, double distance) {
-  entry.hand.angles = mean.angles;
-  entry.hand.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), -turn) * mean.camera_from_hand;
-  entry.wrist_in_camera = CenteredWristPosition(entry.hand.camera_from_hand, bind_centre, distance);
-  return entry;
-}
-
 }  // namespace
 
 // A frame's region as it passes Estimate's stages.
@@ -719,7 +709,8 @@ struct Estimator::Lookup {
   std::vector<Candidate> hyp;
   std::vector<size_t> order;          // hyp by weight, best first
   const Candidate& best() const { return hyp[order[0]]; }
-  std::optional<HandPose> mean;       // with mode_mean: the mode's weighted mean (the frame's image plane, before the ray)
+  // With mode_mean: the best's scene in its database view, the hand posed as the mode's mean.
+  std::optional<Scene> mean;
 };
 
 bool Estimator::Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame, Lookup* lookup, FrameResult* result) {
@@ -891,12 +882,27 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
   std::array<double, kNumHandShapes + 1> grasp_mass{};
   std::array<double, static_cast<int>(ObjectShape::kStick) + 2> object_mass{};
   constexpr size_t kNoObject = static_cast<int>(ObjectShape::kStick) + 1;
+  // The mode's mean (mode_mean) sums the hypotheses of weight near the best, each by its
+  // weight, in the same pass: their distance from the best is the confidence's too.
   double squares = 0.0, mode = 0.0;
+  Eigen::Matrix3d mean_rotation = Eigen::Matrix3d::Zero();
+  JointAngles mean_angles{};
+  double mean_weight = 0.0;
+  int mean_of = 0;
   for (const Candidate& h : hyp) {
     grasp_mass[h.meta.grasp] += h.w;
     object_mass[h.meta.with_object ? static_cast<size_t>(GraspTaxonomy()[h.meta.grasp - 1].object.shape) : kNoObject] += h.w;
     squares += h.w * h.w;
-    if ((h.x - best.x).norm() < options_.sigma_x) mode += h.w;
+    const double from_best = (h.x - best.x).norm();
+    if (from_best < options_.sigma_x) mode += h.w;
+    if (h.w <= 0.0 || from_best >= options_.mode_mean) continue;
+    for (int r = 0; r < 3; ++r) {
+      for (int col = 0; col < 3; ++col) mean_rotation(r, col) += h.w * h.x[3 * r + col];
+    }
+    const JointAngles angles = AnglesOf(h.entry);
+    for (int j = 0; j < kNumDofs; ++j) mean_angles[j] += h.w * angles[j];
+    mean_weight += h.w;
+    ++mean_of;
   }
   for (int g = 1; g <= kNumHandShapes; ++g) {
     if (grasp_mass[g] > 0.0) result->grasps.emplace_back(HandShapeKey(g), grasp_mass[g]);
@@ -924,30 +930,18 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     result->top.push_back(out);
   }
   result->pose = result->top[0].pose;
-  if (options_.mode_mean > 0.0) {
-    // The mode's mean: the hypotheses near the best, each by its weight.
-    Eigen::Matrix3d rotation = Eigen::Matrix3d::Zero();
-    std::array<double, kNumDofs> angles{};
-    double sum = 0.0;
-    int count = 0;
-    for (const Candidate& h : hyp) {
-      if (h.w <= 0.0 || (h.x - best.x).norm() >= options_.mode_mean) continue;
-      for (int r = 0; r < 3; ++r) {
-        for (int col = 0; col < 3; ++col) rotation(r, col) += h.w * h.x[3 * r + col];
-      }
-      const JointAngles a = AnglesOf(h.entry);
-      for (int j = 0; j < kNumDofs; ++j) angles[j] += h.w * a[j];
-      sum += h.w;
-      ++count;
-    }
-    if (count > 1) {
-      HandPose mean;
-      mean.camera_from_hand = NearestRotation(rotation);
-      for (int j = 0; j < kNumDofs; ++j) mean.angles[j] = angles[j] / sum;
-      lookup->mean = mean;
-      result->pose = mean;
-      result->mean_of = count;
-    }
+  if (mean_of > 1) {
+    // The mean's rotation is in the frame's image plane (before the ray); the best's turn
+    // undone puts it in the best's database view, where its wrist is placed as the
+    // database places it.
+    for (double& a : mean_angles) a /= mean_weight;
+    result->pose.angles = mean_angles;
+    result->pose.camera_from_hand = NearestRotation(mean_rotation);
+    result->mean_of = mean_of;
+    Scene& scene = lookup->mean.emplace(EntryScene(best.entry));
+    scene.hand.angles = mean_angles;
+    scene.hand.camera_from_hand = AxisAngle(Eigen::Vector3d::UnitZ(), -best.turn) * result->pose.camera_from_hand;
+    scene.wrist_in_camera = CenteredWristPosition(scene.hand.camera_from_hand, hand_.bind_centre(), db_distance_);
   }
   result->ms.weigh = Ms(t, Clock::now());
   return true;
@@ -981,8 +975,7 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
   auto attempt = [&](const Candidate& c) {
     const cv::Matx23d start_map = PlacementOf(c.entry).crop_from_image;
     // The best starts from the mode's mean, where there is one.
-    Scene start = EntryScene(c.entry);
-    if (&c == &best && lookup.mean.has_value()) start = WithMean(start, *lookup.mean, c.turn, hand_.bind_centre(), db_distance_);
+    const Scene start = &c == &best && lookup.mean.has_value() ? *lookup.mean : EntryScene(c.entry);
     // The track's last rotation in this entry's image plane.
     const Eigen::Matrix3d previous = AxisAngle(Eigen::Vector3d::UnitZ(), -c.turn) * before;
     Tried tried{&c,
@@ -1095,10 +1088,9 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   std::optional<EntryPlacement> placed = Refine(lookup, &turn, &crop, &result);
   if (!placed.has_value() && lookup.mean.has_value()) {
     // The mode's mean, placed through the best's crop.
-    const Candidate& best = lookup.best();
-    const Scene scene = WithMean(EntryScene(best.entry), *lookup.mean, best.turn, hand_.bind_centre(), db_distance_);
-    placed = EntryPlacement{best.entry, 0, PlacementOf(best.entry).crop_from_image, hand_.KeypointsOf(scene.hand),
-                            scene.wrist_in_camera};
+    const uint32_t best = lookup.best().entry;
+    placed = EntryPlacement{best, 0, PlacementOf(best).crop_from_image, hand_.KeypointsOf(lookup.mean->hand),
+                            lookup.mean->wrist_in_camera};
   }
   Place(lookup, crop, placed.has_value() ? *placed : PlacementOf(lookup.best().entry), turn, box, frame, &result);
   return result;
