@@ -145,7 +145,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
     estimator_options.hand = Handedness::kLeft;
     left.emplace(db, index, hand, estimator_options);
   }
-  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, left ? &*left : nullptr, options.given_box, progress);
+  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, left ? &*left : nullptr, {options.given_box, options.max_side}, progress);
   const RealScore score = ScoreReal(labels, predictions);
   EvalRealResult result{ToJson(score), FormatTable(score)};
   result.figures["labels"] = options.labels.string();
@@ -163,6 +163,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["arm_agreement"] = options.arm_agreement;
   result.figures["objects"] = options.objects;
   result.figures["given_box"] = options.given_box;
+  result.figures["max_side"] = options.max_side;
   result.figures["machine"] = MachineDescription();
   if (!options.out_dir.empty()) {
     std::string lines;

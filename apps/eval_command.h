@@ -97,6 +97,8 @@ struct EvalRealCommandOptions : EstimatorFiles {
   // The hand's place given: each labelled hand estimated within its found region (the
   // pose alone judged, apart from finding the hand).
   bool given_box = false;
+  // Frames shrunk to at most this longer side before they are estimated (RealRunOptions).
+  int max_side = 0;
 };
 
 struct EvalRealResult {

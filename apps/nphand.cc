@@ -511,6 +511,10 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_flag("!--no-object", o.objects, kNoObjectHelp);
   cmd->add_flag("--given-box", o.given_box,
                 "The hand's place given: each labelled hand estimated within its box grown by 25 % (its pose judged alone)");
+  cmd->add_option("--max-side", o.max_side,
+                  "Shrink every image and video frame whose longer side exceeds this many pixels until it does not "
+                  "(320: a 320 x 240 webcam's frames; 0: as they are); the keypoints are scored in the labels' pixels")
+      ->capture_default_str();
   cmd->add_option("--hand", o.hand, "given (each labelled side searched for) or auto (the estimator chooses, and is scored)")
       ->capture_default_str();
   cmd->add_flag("--json", json, "Print JSON instead of the table");

@@ -64,6 +64,38 @@ void Record(const Estimator& estimator, const FrameResult& result, RealPredictio
   prediction->missed.push_back({options.hand_auto ? "" : ToString(options.hand), ToString(result.status), result.reason});
 }
 
+// What the estimator sees of a frame: the frame shrunk (area averaging) until its longer
+// side is at most `max_side` pixels (0: as it is).
+cv::Mat Shrunk(const cv::Mat& bgr, int max_side) {
+  const int side = std::max(bgr.cols, bgr.rows);
+  if (max_side == 0 || side <= max_side) return bgr;
+  const double scale = static_cast<double>(max_side) / side;
+  const cv::Size size(std::max(1, static_cast<int>(std::lround(bgr.cols * scale))),
+                      std::max(1, static_cast<int>(std::lround(bgr.rows * scale))));
+  cv::Mat seen;
+  cv::resize(bgr, seen, size, 0.0, 0.0, cv::INTER_AREA);
+  return seen;
+}
+
+// The estimate on `seen` (the frame of size `frame` shrunk), its 2D keypoints in the
+// frame's pixels; `roi` is in the frame's pixels.
+FrameResult ProcessShrunk(Estimator* estimator, const cv::Mat& seen, cv::Size frame, double time_s,
+                          const std::optional<cv::Rect>& roi) {
+  const double sx = static_cast<double>(seen.cols) / frame.width, sy = static_cast<double>(seen.rows) / frame.height;
+  std::optional<cv::Rect> seen_roi;
+  if (roi.has_value()) {
+    const int x0 = static_cast<int>(std::floor(roi->x * sx)), y0 = static_cast<int>(std::floor(roi->y * sy));
+    const int x1 = static_cast<int>(std::ceil((roi->x + roi->width) * sx));
+    const int y1 = static_cast<int>(std::ceil((roi->y + roi->height) * sy));
+    seen_roi = cv::Rect(x0, y0, x1 - x0, y1 - y0);
+  }
+  FrameResult result = estimator->Process(seen, time_s, seen_roi);
+  if (result.detected() && seen.size() != frame) {
+    for (Eigen::Vector2d& k : result.keypoints_2d) k = Eigen::Vector2d(k.x() / sx, k.y() / sy);
+  }
+  return result;
+}
+
 }  // namespace
 
 void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem::path& root) {
@@ -84,7 +116,9 @@ void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem:
 }
 
 std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, const std::filesystem::path& root,
-                                         Estimator* right, Estimator* left, bool given_box, std::ostream* progress) {
+                                         Estimator* right, Estimator* left, const RealRunOptions& run, std::ostream* progress) {
+  NPHAND_THROW_CHECK(run.max_side == 0 || run.max_side >= 16, "eval real: the longest side must be 0 (as it is) or at least 16 pixels, not ",
+                     run.max_side);
   // Images and videos in the order of their first label; the sides labelled in each, and
   // the labels of each still and of each video frame.
   std::vector<std::string> stills, videos;
@@ -116,13 +150,14 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
   std::vector<RealPrediction> predictions;
   for (const std::string& file : stills) {
     const cv::Mat bgr = ReadStill(root / file);
+    const cv::Mat seen = Shrunk(bgr, run.max_side);
     RealPrediction prediction;
     prediction.file = file;
     prediction.ms = 0.0;
     // One estimate a labelled side, or one in all when the estimator chooses the side; with
     // the place given, one a labelled hand, within its region.
     std::vector<std::pair<Estimator*, std::optional<cv::Rect>>> estimates;
-    if (given_box) {
+    if (run.given_box) {
       for (const RealLabel* label : of_still[file]) estimates.emplace_back(estimator_of(label->hand), region_of(*label));
     } else if (left != nullptr) {
       for (const std::string& side : sides[file]) estimates.emplace_back(estimator_of(side), std::nullopt);
@@ -131,7 +166,7 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
     }
     for (const auto& [estimator, roi] : estimates) {
       estimator->Reset();
-      const FrameResult result = estimator->Process(bgr, 0.0, roi);
+      const FrameResult result = ProcessShrunk(estimator, seen, bgr.size(), 0.0, roi);
       *prediction.ms += result.ms.total;
       Record(*estimator, result, &prediction);
     }
@@ -151,8 +186,8 @@ std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, c
       NPHAND_THROW_CHECK(video.read(bgr) && !bgr.empty(), (root / file).string(), ": ends at frame ", frame,
                          ", but frames up to ", last, " are labelled");
       std::optional<cv::Rect> roi;
-      if (const auto it = of_frame.find({file, frame}); given_box && it != of_frame.end()) roi = region_of(*it->second);
-      const FrameResult result = estimator->Process(bgr, frame / fps, roi);
+      if (const auto it = of_frame.find({file, frame}); run.given_box && it != of_frame.end()) roi = region_of(*it->second);
+      const FrameResult result = ProcessShrunk(estimator, Shrunk(bgr, run.max_side), bgr.size(), frame / fps, roi);
       if (frames[file].count(frame)) {
         RealPrediction prediction;
         prediction.file = file;

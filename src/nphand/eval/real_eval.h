@@ -21,18 +21,29 @@ namespace nphand {
 // not, before any estimation.
 void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem::path& root);
 
+// How `EstimateReal` shows the frames to the estimator.
+struct RealRunOptions {
+  // The hand's place given: each labelled hand is estimated alone, in its found region (its
+  // box grown by 25 %, see real_score.h) as the estimator's region of interest, by the
+  // estimator of its side (with `left`), and each labelled video frame within its label's
+  // region.
+  bool given_box = false;
+  // Each image and video frame whose longer side exceeds this many pixels is shrunk (area
+  // averaging) until it does not, before the estimator sees it: how nphand fares at a
+  // webcam's resolution (320: a 320 x 240 camera's frames). The predictions' 2D keypoints
+  // are mapped back to the labels' pixels. 0: every frame as it is.
+  int max_side = 0;
+};
+
 // The estimator's predictions for every labelled image and video frame. With `left`, the
 // hand's side is the label's ("given"): each side labelled in an image is estimated once,
 // by `right` or `left` (estimators over one database, differing in their `hand`), each
 // reset first; an image without a labelled side is estimated as a right hand. Without
 // `left` (null), `right` chooses the side itself (hand_auto) and each image is estimated
-// once. With `given_box`, the hand's place is given and only its pose is estimated: each
-// labelled hand is estimated alone, in its found region (its box grown by 25 %, see
-// real_score.h) as the estimator's region of interest, by the estimator of its side (with
-// `left`), and each labelled video frame within its label's region. `progress` (if not
-// null) gets a progress line.
+// once. `progress` (if not null) gets a progress line. Throws nphand::Error for a
+// max_side that is negative or under 16.
 std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, const std::filesystem::path& root,
-                                         Estimator* right, Estimator* left, bool given_box, std::ostream* progress);
+                                         Estimator* right, Estimator* left, const RealRunOptions& run, std::ostream* progress);
 
 // A contact sheet of the stills: each image with its labelled keypoints (green rings; a
 // HaGRID box as a green rectangle) and the predicted skeletons, captioned found or missed.
