@@ -111,6 +111,9 @@ std::vector<EstimatorScore> RunEvalEstimator(const EvalEstimatorCommandOptions& 
 EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* progress) {
   NPHAND_THROW_CHECK(!options.labels.empty(), "eval real: --labels is required (e.g. ../shared/real-dev/labels.jsonl)");
   NPHAND_THROW_CHECK(options.hand == "given" || options.hand == "auto", "eval real: --hand is given or auto, not '", options.hand, "'");
+  const RealRunOptions run{.given_box = options.given_box, .max_side = options.max_side};
+  std::string why;
+  NPHAND_THROW_CHECK(run.Check(&why), "eval real: ", why);
   if (!options.out_dir.empty()) {
     CheckOutputFolder(options.out_dir, "eval real --out");
     std::vector<NamedPath> inputs = options.Inputs();
@@ -145,7 +148,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
     estimator_options.hand = Handedness::kLeft;
     left.emplace(db, index, hand, estimator_options);
   }
-  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, left ? &*left : nullptr, {options.given_box, options.max_side}, progress);
+  const std::vector<RealPrediction> predictions = EstimateReal(labels, root, &right, left ? &*left : nullptr, run, progress);
   const RealScore score = ScoreReal(labels, predictions);
   EvalRealResult result{ToJson(score), FormatTable(score)};
   result.figures["labels"] = options.labels.string();

@@ -4,6 +4,7 @@
 // the full database does; what is tested is where the estimator looks, not its pose.
 #include "nphand/eval/real_eval.h"
 
+#include <array>
 #include <memory>
 #include <set>
 #include <string>
@@ -140,9 +141,9 @@ TEST(RealEvalTest, WithTheBoxGivenEachLabelledHandIsEstimatedInItsRegion) {
 }
 
 // A frame shrunk before the estimator sees it (a webcam's lower resolution): the hand is
-// still found, its keypoints come back in the labels' pixels, near where the whole frame
-// puts them; a longest side under 16 pixels is refused by name, and one beyond the frame's
-// leaves it as it is.
+// still found, also within its region given, its keypoints come back in the labels' pixels,
+// near where the whole frame puts them; a longer side of the frame's own or more leaves the
+// frame as it is, and one under 16 pixels is refused by name.
 TEST(RealEvalTest, AShrunkFrameIsScoredInTheLabelsPixels) {
   const auto dir = testing::ScratchDir();
   const Database db = Database::Open(testing::BuildTinyDatabase(dir / "tiny.db"));
@@ -170,25 +171,32 @@ TEST(RealEvalTest, AShrunkFrameIsScoredInTheLabelsPixels) {
   const std::vector<RealPrediction> whole = EstimateReal(labels, dir, &right, nullptr, {}, nullptr);
   ASSERT_EQ(whole.size(), 1u);
   ASSERT_EQ(whole[0].hands.size(), 1u);
-  for (int side : {160, 80}) {
-    const std::vector<RealPrediction> shrunk = EstimateReal(labels, dir, &right, nullptr, {.max_side = side}, nullptr);
+  for (const RealRunOptions run : {RealRunOptions{.max_side = 160}, RealRunOptions{.max_side = 80},
+                                   RealRunOptions{.given_box = true, .max_side = 160}}) {
+    const std::string name = std::to_string(run.max_side) + (run.given_box ? ", box given" : "");
+    const std::vector<RealPrediction> shrunk = EstimateReal(labels, dir, &right, nullptr, run, nullptr);
     ASSERT_EQ(shrunk.size(), 1u);
-    ASSERT_EQ(shrunk[0].hands.size(), 1u) << side;
-    EXPECT_TRUE(ScoreReal(labels, shrunk).hands[0].found) << side;
+    ASSERT_EQ(shrunk[0].hands.size(), 1u) << name;
+    EXPECT_TRUE(ScoreReal(labels, shrunk).hands[0].found) << name;
+    EXPECT_NE(shrunk[0].hands[0].keypoints_2d, whole[0].hands[0].keypoints_2d) << name << ": not shrunk";
     // Within a sixth of the hand's diagonal of the whole frame's estimate (measured: 0.006
     // of it at a half, 0.08 at a quarter, where the hand's keypoints span 39 pixels).
-    EXPECT_LT((centre(shrunk[0]) - centre(whole[0])).norm(), diagonal / 6.0) << side;
+    EXPECT_LT((centre(shrunk[0]) - centre(whole[0])).norm(), diagonal / 6.0) << name;
   }
-  const std::vector<RealPrediction> beyond = EstimateReal(labels, dir, &right, nullptr, {.max_side = 640}, nullptr);
-  ASSERT_EQ(beyond.size(), 1u);
-  ASSERT_EQ(beyond[0].hands.size(), 1u);
-  EXPECT_EQ(beyond[0].hands[0].keypoints_2d, whole[0].hands[0].keypoints_2d);
+  for (int side : {320, 640}) {
+    const std::vector<RealPrediction> as_is = EstimateReal(labels, dir, &right, nullptr, {.max_side = side}, nullptr);
+    ASSERT_EQ(as_is.size(), 1u);
+    ASSERT_EQ(as_is[0].hands.size(), 1u) << side;
+    EXPECT_EQ(as_is[0].hands[0].keypoints_2d, whole[0].hands[0].keypoints_2d) << side;
+  }
+  // The smallest side taken: a 16 x 12 frame, estimated (no hand in it is an answer too).
+  EXPECT_EQ(EstimateReal(labels, dir, &right, nullptr, {.max_side = 16}, nullptr).size(), 1u);
   for (int side : {-1, 8}) {
     try {
       EstimateReal(labels, dir, &right, nullptr, {.max_side = side}, nullptr);
       ADD_FAILURE() << side << " was taken";
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("longest side"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("--max-side"), std::string::npos) << e.what();
     }
   }
 }

@@ -77,8 +77,10 @@ cv::Mat Shrunk(const cv::Mat& bgr, int max_side) {
   return seen;
 }
 
-// The estimate on `seen` (the frame of size `frame` shrunk), its 2D keypoints in the
-// frame's pixels; `roi` is in the frame's pixels.
+// The estimate on `seen` (the frame of size `frame` shrunk), its 2D keypoints mapped back
+// to the frame's pixels; `roi` is in the frame's pixels. Only the 2D keypoints are mapped
+// (all that is scored): the box, the camera-frame keypoints and the depth stay the shrunk
+// frame's.
 FrameResult ProcessShrunk(Estimator* estimator, const cv::Mat& seen, cv::Size frame, double time_s,
                           const std::optional<cv::Rect>& roi) {
   const double sx = static_cast<double>(seen.cols) / frame.width, sy = static_cast<double>(seen.rows) / frame.height;
@@ -97,6 +99,14 @@ FrameResult ProcessShrunk(Estimator* estimator, const cv::Mat& seen, cv::Size fr
 }
 
 }  // namespace
+
+bool RealRunOptions::Check(std::string* why) const {
+  if (max_side != 0 && max_side < 16) {
+    *why = "--max-side (the frames' longer side) is 0 (as they are) or at least 16 pixels, not " + std::to_string(max_side);
+    return false;
+  }
+  return true;
+}
 
 void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem::path& root) {
   std::set<std::string> checked;
@@ -117,8 +127,8 @@ void CheckRealFiles(const std::vector<RealLabel>& labels, const std::filesystem:
 
 std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, const std::filesystem::path& root,
                                          Estimator* right, Estimator* left, const RealRunOptions& run, std::ostream* progress) {
-  NPHAND_THROW_CHECK(run.max_side == 0 || run.max_side >= 16, "eval real: the longest side must be 0 (as it is) or at least 16 pixels, not ",
-                     run.max_side);
+  std::string why;
+  NPHAND_THROW_CHECK(run.Check(&why), "eval real: ", why);
   // Images and videos in the order of their first label; the sides labelled in each, and
   // the labels of each still and of each video frame.
   std::vector<std::string> stills, videos;

@@ -33,6 +33,8 @@ struct RealRunOptions {
   // webcam's resolution (320: a 320 x 240 camera's frames). The predictions' 2D keypoints
   // are mapped back to the labels' pixels. 0: every frame as it is.
   int max_side = 0;
+  // False, with why, for a max_side other than 0 and under 16.
+  bool Check(std::string* why) const;
 };
 
 // The estimator's predictions for every labelled image and video frame. With `left`, the
@@ -40,8 +42,8 @@ struct RealRunOptions {
 // by `right` or `left` (estimators over one database, differing in their `hand`), each
 // reset first; an image without a labelled side is estimated as a right hand. Without
 // `left` (null), `right` chooses the side itself (hand_auto) and each image is estimated
-// once. `progress` (if not null) gets a progress line. Throws nphand::Error for a
-// max_side that is negative or under 16.
+// once. `progress` (if not null) gets a progress line. Throws nphand::Error for `run`
+// that fails its Check.
 std::vector<RealPrediction> EstimateReal(const std::vector<RealLabel>& labels, const std::filesystem::path& root,
                                          Estimator* right, Estimator* left, const RealRunOptions& run, std::ostream* progress);
 
