@@ -92,7 +92,7 @@ FrameResult ProcessShrunk(Estimator* estimator, const cv::Mat& seen, cv::Size fr
     seen_roi = cv::Rect(x0, y0, x1 - x0, y1 - y0);
   }
   FrameResult result = estimator->Process(seen, time_s, seen_roi);
-  if (result.detected() && seen.size() != frame) {
+  if (result.detected()) {
     for (Eigen::Vector2d& k : result.keypoints_2d) k = Eigen::Vector2d(k.x() / sx, k.y() / sy);
   }
   return result;
