@@ -80,6 +80,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
   estimator_options.track_views = options.track_views;
   SetHandChoice(options.hand, &estimator_options);
   estimator_options.refine = options.refine;
+  estimator_options.tilts_deg = options.tilts_deg;
   Estimator estimator(db, index, hand, estimator_options);
   const double rss_loaded = PeakRssMb();
 
@@ -129,6 +130,7 @@ nlohmann::json RunBenchPipeline(const BenchPipelineOptions& options) {
       {"k", options.k},
       {"track_views", options.track_views},
       {"refine", options.refine},
+      {"tilts_deg", options.tilts_deg},
       {"face", options.face},
       {"hand", options.hand},
       {"peak_rss_mb", PeakRssMb()},

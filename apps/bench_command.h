@@ -39,6 +39,7 @@ struct BenchPipelineOptions : EstimatorFiles {
   int track_views = EstimatorOptions{}.track_views;  // viewpoints of the track's views measured besides
   std::string hand = "right";   // right, left or auto
   bool refine = false;          // the estimator refines its best view (refine/refiner.h)
+  std::vector<double> tilts_deg = EstimatorOptions{}.tilts_deg;  // the crop's tilts where the match is poor
   // A face beside the hand in every frame, as before a webcam: the face cascade and the
   // skin gate read from the face are then part of the time.
   bool face = true;

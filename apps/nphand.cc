@@ -230,6 +230,14 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--roll-ambiguity", e.roll_ambiguity,
                   "Search the half-turned crop too when the silhouette's skewness is below this (0: never)")
       ->capture_default_str();
+  cmd->add_option("--tilts", e.tilts_deg,
+                  "Where the nearest view lies --tilt-above or farther, search the crop turned by plus and minus each of these "
+                  "degrees too")
+      ->expected(1, 8)
+      ->capture_default_str();
+  cmd->add_flag_callback("--no-tilts", [&e] { e.tilts_deg.clear(); }, "Never search the crop tilted");
+  cmd->add_option("--tilt-above", e.tilt_above, "Search the crop's tilts where the nearest view lies this far or farther (0: on every frame)")
+      ->capture_default_str();
   cmd->add_option("--focal", e.focal_px, "Focal length in pixels (0: from --fov)")->capture_default_str();
   cmd->add_option("--fov", e.fov_deg, "Horizontal field of view, degrees")->capture_default_str();
   cmd->add_option("--hand-length", e.hand_length_m, "Wrist to middle fingertip, metres")->capture_default_str();
@@ -283,6 +291,8 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
       ->capture_default_str();
   pipeline->add_option("--hand", p.hand, "right, left or auto (both sides searched)")->capture_default_str();
   pipeline->add_flag("--refine", p.refine, "Refine the best view's pose (its cost is ms.refine)");
+  pipeline->add_option("--tilts", p.tilts_deg, "The crop's tilts where the match is poor, degrees")->expected(1, 8)->capture_default_str();
+  pipeline->add_flag_callback("--no-tilts", [&p] { p.tilts_deg.clear(); }, "Never search the crop tilted (what the tilts cost)");
   pipeline->add_flag("--face,!--no-face", p.face, "A face beside the hand in every frame (the face cascade and its skin gate timed too)")
       ->capture_default_str();
   pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->check(WholeNumber())->capture_default_str();

@@ -1,5 +1,6 @@
 #include "nphand/features/crop.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -123,6 +124,44 @@ TEST(CropTest, CropFromImageMapsSourcePixelsOntoTheCrop) {
   cv::Mat disc(100, 100, CV_8UC1, cv::Scalar(0));
   cv::circle(disc, {50, 50}, 30, cv::Scalar(255), cv::FILLED);
   EXPECT_LT(CropHand(disc, {64, 0.1, true})->roll_skewness, 0.02);
+}
+
+TEST(CropTest, ATiltedCropTurnsItsImageItsRollAndItsMapTogether) {
+  cv::Mat mask(150, 200, CV_8UC1, cv::Scalar(0));
+  cv::rectangle(mask, cv::Rect(60, 30, 20, 90), cv::Scalar(255), cv::FILLED);
+  cv::circle(mask, {70, 35}, 18, cv::Scalar(255), cv::FILLED);
+  const HandCrop crop = *CropHand(mask, {.size = 64, .margin = 0.1, .normalize_roll = true});
+  // The knob's centre and the bar's far end lie on the shape; beside the bar, off it.
+  const std::vector<cv::Point2d> on = {{70, 35}, {70, 115}}, off = {{95, 110}, {45, 110}};
+  const auto at = [](const HandCrop& c, const cv::Point2d& p) {
+    const cv::Matx23d& a = c.crop_from_image;
+    const cv::Point2d q(a(0, 0) * p.x + a(0, 1) * p.y + a(0, 2), a(1, 0) * p.x + a(1, 1) * p.y + a(1, 2));
+    EXPECT_TRUE(q.x >= 0 && q.y >= 0 && q.x < c.image.cols && q.y < c.image.rows) << q;
+    return c.image.at<float>(std::clamp(static_cast<int>(std::lround(q.y)), 0, c.image.rows - 1),
+                             std::clamp(static_cast<int>(std::lround(q.x)), 0, c.image.cols - 1));
+  };
+  for (double degrees : {15.0, -30.0, 90.0}) {
+    const HandCrop tilted = TiltCrop(crop, degrees * std::numbers::pi / 180.0);
+    EXPECT_NEAR(std::remainder(tilted.roll - crop.roll - degrees * std::numbers::pi / 180.0, 2 * std::numbers::pi), 0.0, 1e-9);
+    EXPECT_EQ(tilted.roll_skewness, crop.roll_skewness);
+    for (const cv::Point2d& p : on) EXPECT_GT(at(tilted, p), 0.5f) << degrees;
+    for (const cv::Point2d& p : off) EXPECT_LT(at(tilted, p), 0.5f) << degrees;
+    // The shape stays within the square (the crop's margin holds it at these turns).
+    EXPECT_NEAR(cv::sum(tilted.image)[0], cv::sum(crop.image)[0], 0.03 * cv::sum(crop.image)[0]) << degrees;
+    // Turned back, the middle of the square is the crop's again (but for two bilinear
+    // resamplings of its edges).
+    const HandCrop back = TiltCrop(tilted, -degrees * std::numbers::pi / 180.0);
+    const cv::Rect middle(16, 16, 32, 32);
+    EXPECT_LT(cv::norm(back.image(middle), crop.image(middle), cv::NORM_L1) / cv::sum(crop.image(middle))[0], 0.1) << degrees;
+    for (int r = 0; r < 2; ++r) {
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(back.crop_from_image(r, c), crop.crop_from_image(r, c), 1e-9);
+    }
+  }
+  // A tilt leaves the crop it was made from as it was.
+  const cv::Mat before = crop.image.clone();
+  const HandCrop tilted = TiltCrop(crop, 0.3);
+  EXPECT_EQ(cv::norm(before, crop.image, cv::NORM_INF), 0.0);
+  EXPECT_NE(tilted.image.data, crop.image.data);
 }
 
 }  // namespace

@@ -176,6 +176,35 @@ TEST_P(BackendTest, BatchSearchEqualsOneAtATime) {
   }
 }
 
+// A search with less effort: hnswlib's (codes or floats) is the search of an index whose
+// ef_search is that effort (the same graph: its build does not read ef_search); every
+// other backend searches as it always does. An effort under 1 is refused.
+TEST_P(BackendTest, ASearchWithLessEffortSearchesWithThatCandidateList) {
+  IndexOptions options = GetParam().approximate;
+  options.hnsw.ef_search = 200;
+  const std::unique_ptr<KnnIndex> index = BuildIndex(db(), options);
+  const bool graph = (options.backend == "hnswlib" || options.backend == "hnswlib-sq8") && options.hnsw.pca == 0;
+  constexpr int kEffort = 12;
+  IndexOptions narrow_options = options;
+  narrow_options.hnsw.ef_search = kEffort;
+  const std::unique_ptr<KnnIndex> narrow = graph ? BuildIndex(db(), narrow_options) : nullptr;
+  const IndexedSet all = DatabaseDescriptors(db());
+  size_t differ = 0;
+  for (size_t r = 0; r < all.ids.size(); r += 17) {
+    for (int k : {1, 10}) {
+      const Neighbours got = index->Search(QueryOf(all.ids[r]), k, kEffort);
+      const Neighbours want = graph ? narrow->Search(QueryOf(all.ids[r]), k) : index->Search(QueryOf(all.ids[r]), k);
+      EXPECT_EQ(got.ids, want.ids) << r << " k=" << k;
+      EXPECT_EQ(got.distances, want.distances) << r << " k=" << k;
+      differ += graph && got.ids != index->Search(QueryOf(all.ids[r]), k).ids;
+    }
+  }
+  if (graph) {
+    EXPECT_GT(differ, 0u) << "a candidate list of " << kEffort << " finds what one of 200 does on every query";
+  }
+  testing::ExpectError([&] { index->Search(QueryOf(all.ids[0]), 5, 0); }, "the effort must be at least 1");
+}
+
 // Distances to chosen entries are measured as the search measures them: those of the
 // entries a search found are its own; an entry the index does not hold is refused by name.
 TEST_P(BackendTest, DistancesToChosenEntriesAreTheSearchsOwn) {

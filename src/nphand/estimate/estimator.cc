@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <opencv2/imgproc.hpp>
@@ -22,6 +23,9 @@ namespace nphand {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// The nearest neighbour's squared distance (infinite for none).
+float Nearest(const Neighbours& n) { return n.distances.empty() ? std::numeric_limits<float>::infinity() : n.distances.front(); }
 
 double Ms(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double, std::milli>(to - from).count();
@@ -196,6 +200,10 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the mode's mean must reach within [0, 10) of the best hypothesis";
   } else if (!(roll_ambiguity >= 0.0 && roll_ambiguity < 10.0) || !(max_distance > 0.0 && max_distance < 10.0)) {
     *why = "roll ambiguity must be within [0, 10) and the largest distance within (0, 10)";
+  } else if (std::any_of(tilts_deg.begin(), tilts_deg.end(), [](double t) { return !(t > 0.0 && t <= 90.0); })) {
+    *why = "each tilt of the crop must be within (0, 90] degrees";
+  } else if (!(tilt_above >= 0.0 && tilt_above < 10.0) || tilt_k < 1 || tilt_effort < 1) {
+    *why = "the distance above which the crop is tilted must be within [0, 10), and the tilts' k and effort at least 1";
   } else if (!(focal_px >= 0.0 && focal_px < 1e6) || !(fov_deg > 1.0 && fov_deg < 179.0)) {
     *why = "the focal length must be >= 0 pixels (0: from the field of view) and the field of view within (1, 179) degrees";
   } else if (!(hand_length_m >= 0.05 && hand_length_m <= 0.4)) {
@@ -703,7 +711,9 @@ struct Candidate {
 struct Estimator::Lookup {
   std::optional<cv::Point2d> arm;     // the forearm's direction, if one was cut off
   cv::Rect roi;                       // the hand's box, padded, within the frame
-  std::vector<HandCrop> crops;        // the crop, and its half turn when its ends look alike
+  std::vector<HandCrop> crops;        // the crop, its half turn when its ends look alike, their tilts
+  std::vector<int> half_of;           // per crop: 0 for the crop and its tilts, 1 for the half turn and its tilts
+  size_t untilted = 1;                // crops before the tilts
   std::vector<Descriptor> descriptors;
   std::vector<Neighbours> found;      // per crop
   std::vector<Candidate> hyp;
@@ -730,7 +740,11 @@ bool Estimator::Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame,
     return false;
   }
   lookup->crops = {*crop};
-  if (config.normalize_roll && crop->roll_skewness < options_.roll_ambiguity) lookup->crops.push_back(HalfTurn(*crop));
+  lookup->half_of = {0};
+  if (config.normalize_roll && crop->roll_skewness < options_.roll_ambiguity) {
+    lookup->crops.push_back(HalfTurn(*crop));
+    lookup->half_of.push_back(1);
+  }
   for (const HandCrop& c : lookup->crops) lookup->descriptors.push_back(DescribeCrop(c, config));
   result->both_turns = lookup->crops.size() == 2;
   result->ms.describe = Ms(t, Clock::now());
@@ -739,12 +753,36 @@ bool Estimator::Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame,
 
 void Estimator::Search(Lookup* lookup, FrameResult* result) {
   const Clock::time_point t = Clock::now();
+  const double described = result->ms.describe;
   for (const Descriptor& d : lookup->descriptors) lookup->found.push_back(index_.Search(d, options_.k));
+  // A poor match: the crops turned a little each way too (their describing timed apart).
+  float nearest = std::numeric_limits<float>::infinity();
+  for (const Neighbours& n : lookup->found) nearest = std::min(nearest, Nearest(n));
+  const size_t searched = lookup->untilted = lookup->crops.size();
+  // (Beyond max_distance the region is no hand, tilted or not.)
+  const double seen = std::sqrt(nearest);
+  if (!options_.tilts_deg.empty() && db_.descriptor().normalize_roll && seen >= options_.tilt_above && seen <= options_.max_distance) {
+    result->tilted = true;
+    // Of the two turns, the one whose nearest view is nearer (the other's tilts won no frame
+    // of the validation sweep).
+    size_t c = 0;
+    if (searched == 2 && Nearest(lookup->found[1]) < Nearest(lookup->found[0])) c = 1;
+    for (double tilt : options_.tilts_deg) {
+      for (double sign : {-1.0, 1.0}) {
+        const Clock::time_point d = Clock::now();
+        lookup->crops.push_back(TiltCrop(lookup->crops[c], sign * tilt * std::numbers::pi / 180.0));
+        lookup->half_of.push_back(lookup->half_of[c]);
+        lookup->descriptors.push_back(DescribeCrop(lookup->crops.back(), db_.descriptor()));
+        result->ms.describe += Ms(d, Clock::now());
+        lookup->found.push_back(index_.Search(lookup->descriptors.back(), options_.tilt_k, options_.tilt_effort));
+      }
+    }
+  }
   if (options_.track_views > 0 && !carried_.empty() && carried_[0].entry.has_value()) {
     const std::vector<int>& views = near_views_[entries_[*carried_[0].entry].meta.viewpoint];
     std::vector<entry_id_t> more;
     std::vector<float> distances;
-    for (size_t c = 0; c < lookup->descriptors.size(); ++c) {
+    for (size_t c = 0; c < searched; ++c) {
       Neighbours& found = lookup->found[c];
       if (++searches_ == 0) {  // the counter wrapped: forget every mark
         std::fill(found_in_.begin(), found_in_.end(), 0);
@@ -762,7 +800,7 @@ void Estimator::Search(Lookup* lookup, FrameResult* result) {
       found.distances.insert(found.distances.end(), distances.begin(), distances.end());
     }
   }
-  result->ms.search = Ms(t, Clock::now());
+  result->ms.search = Ms(t, Clock::now()) - (result->ms.describe - described);
 }
 
 bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
@@ -811,14 +849,19 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     result->ms.weigh = Ms(t, Clock::now());
     return false;
   }
-  double nearest = hyp[0].distance;
-  for (const Candidate& h : hyp) nearest = std::min(nearest, h.distance);
+  // Whether the region is a hand at all is judged by its own crop's matches: a tilt reads
+  // a hand's silhouette better, it does not make a region a hand.
+  double nearest = hyp[0].distance, untilted = std::numeric_limits<double>::infinity();
+  for (const Candidate& h : hyp) {
+    nearest = std::min(nearest, h.distance);
+    if (static_cast<size_t>(h.turn_of) < lookup->untilted) untilted = std::min(untilted, h.distance);
+  }
   result->searched = true;
   result->nearest_distance = nearest;
-  if (nearest > options_.max_distance) {
+  if (untilted > options_.max_distance) {
     result->status = FrameStatus::kNotAHand;
     result->reason = "nothing in the database looks like this region (nearest feature distance " +
-                     std::to_string(nearest) + " > " + std::to_string(options_.max_distance) + ")";
+                     std::to_string(untilted) + " > " + std::to_string(options_.max_distance) + ")";
     result->box = box;
     result->ms.weigh = Ms(t, Clock::now());
     return false;
@@ -986,12 +1029,12 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
     return tried;
   };
   Tried chosen = attempt(best);
-  if (options_.refine_both_turns && lookup.crops.size() == 2) {
+  if (options_.refine_both_turns && result->both_turns) {
     // The silhouette's ends look alike: the best of the other turn is refined too, and
     // replaces the lookup's best only if the silhouette agrees with it better and it is no
     // farther from the last frame's rotation.
     for (size_t i : lookup.order) {
-      if (lookup.hyp[i].turn_of == best.turn_of) continue;
+      if (lookup.half_of[lookup.hyp[i].turn_of] == lookup.half_of[best.turn_of]) continue;
       Tried other = attempt(lookup.hyp[i]);
       if (other.r.disagreement_after < chosen.r.disagreement_after && other.from_last <= chosen.from_last) chosen = std::move(other);
       break;
@@ -1086,6 +1129,8 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   double turn = 0.0;
   int crop = 0;
   std::optional<EntryPlacement> placed = Refine(lookup, &turn, &crop, &result);
+  result.tilt_deg = std::remainder(lookup.crops[crop].roll - lookup.crops[lookup.half_of[crop]].roll, 2.0 * std::numbers::pi) /
+                    (std::numbers::pi / 180.0);
   if (!placed.has_value() && lookup.mean.has_value()) {
     // The mode's mean, placed through the best's crop.
     const uint32_t best = lookup.best().entry;

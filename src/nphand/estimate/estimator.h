@@ -79,6 +79,19 @@ struct EstimatorOptions {
   // 0.05 searches twice in a quarter of the frames (0.15: 58 %), for 0.2 mm more error and
   // 11-15 % more frames a second (docs/estimator.md).
   double roll_ambiguity = 0.05;
+  // Where the nearest view of the crop (and of its half turn) lies tilt_above or farther (0:
+  // every frame) but within max_distance, the crop (of the two turns, the nearer's) is
+  // searched again turned by plus and minus each of tilts_deg: a segmented silhouette's
+  // principal axis errs (a forearm's stump, an object's hole, stray skin beside it), where
+  // the database's renders were turned by their own. Each turned crop's tilt_k nearest views
+  // are found with a candidate list of tilt_effort (KnnIndex::Search) and weighed with the
+  // rest; whether the region is a hand at all stays the untilted crop's to say
+  // (max_distance). The validation sweep's choice (docs/estimator.md): 15 and 30 degrees
+  // from 0.6, on 9 % of its RGB frames, 14.5 -> 13.8 mm. None: tilts_deg empty.
+  std::vector<double> tilts_deg = {15.0, 30.0};
+  double tilt_above = 0.6;
+  int tilt_k = 30;
+  int tilt_effort = 50;
   // No hand unless the nearest database entry is at most this far in feature space.
   double max_distance = 0.8;
   // No hand when the silhouette's principal axes are farther apart than this ratio: a sliver
@@ -196,6 +209,8 @@ struct FrameResult {
   cv::Rect box;                                // the hand's pixels (after the forearm cut)
   bool forearm_cut = false;
   bool both_turns = false;                     // the half-turned crop was searched too
+  bool tilted = false;                         // the crop was searched turned too (EstimatorOptions::tilts_deg)
+  double tilt_deg = 0.0;                       // the turn of the crop the estimate came through (0: untilted)
   bool prior_used = false;                     // the temporal prior took part
   std::vector<Hypothesis> top;                 // the best top_n, best first
   std::vector<std::pair<std::string, double>> grasps;   // posterior over hand shapes (grasps, gestures), descending

@@ -75,6 +75,8 @@ nlohmann::json FrameResultJson(const FrameResult& r, const Database& db, bool wi
   j["nearest_distance"] = r.nearest_distance;
   j["forearm_cut"] = r.forearm_cut;
   j["both_turns"] = r.both_turns;
+  j["tilted"] = r.tilted;
+  j["tilt_deg"] = r.tilt_deg;
   j["prior_used"] = r.prior_used;
   j["entry"] = r.top[0].entry;
   if (with_top) {

@@ -191,6 +191,23 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
   for (int views : {0, 8}) {
     around_default("track-views" + std::to_string(views), [&](EstimatorOptions& e) { e.track_views = views; });
   }
+  // The crop's tilts where the match is poor: none, other angles, other thresholds, more
+  // neighbours and a fuller search of each.
+  const std::vector<std::pair<std::string, std::vector<double>>> tilts = {
+      {"none", {}}, {"10", {10.0}}, {"20", {20.0}}, {"30", {30.0}}, {"20-40", {20.0, 40.0}}, {"10-20-30", {10.0, 20.0, 30.0}}};
+  for (const auto& [name, degrees] : tilts) {
+    around_default("tilts-" + name, [&](EstimatorOptions& e) { e.tilts_deg = degrees; });
+  }
+  for (double above : {0.5, 0.55, 0.65, 0.7}) {
+    std::ostringstream name;
+    name << "tilt-above" << above;
+    around_default(name.str(), [&](EstimatorOptions& e) { e.tilt_above = above; });
+  }
+  around_default("tilt-effort100", [&](EstimatorOptions& e) { e.tilt_effort = 100; });
+  around_default("tilt-k500-effort500", [&](EstimatorOptions& e) {
+    e.tilt_k = 500;
+    e.tilt_effort = 500;
+  });
   return out;
 }
 
@@ -262,6 +279,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     score.options = {{"k", e.k},           {"observation", ToString(e.observation)}, {"sigma_y", e.sigma_y},
                      {"prior", ToString(e.prior)}, {"sigma_x", e.sigma_x}, {"prior_share", e.prior_share},
                      {"carried", e.carried},        {"carry_apart_frames", e.carry_apart_frames}, {"roll_ambiguity", e.roll_ambiguity},
+                     {"tilts_deg", e.tilts_deg}, {"tilt_above", e.tilt_above}, {"tilt_k", e.tilt_k}, {"tilt_effort", e.tilt_effort},
                      {"mode_mean", e.mode_mean},       {"refine", RefinementJson(e)},
                      {"smooth", SmoothingJson(e)}};
     std::vector<double> ms;
@@ -289,6 +307,7 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
         run.push_back(r.keypoints_hand);
         ++score.detected;
         score.both_turns += r.both_turns;
+        score.tilted += r.tilted;
         double joint = 0.0, px = 0.0, camera = 0.0;
         for (int d = 0; d < kNumDofs; ++d) joint += std::abs(r.pose.angles[d] - truth.pose.angles[d]);
         for (int k = 0; k < kNumKeypoints; ++k) {
@@ -331,6 +350,7 @@ nlohmann::json ToJson(const std::vector<EstimatorScore>& scores) {
                     {"frames", s.frames},
                     {"detected", s.detected},
                     {"both_turns", s.both_turns},
+                    {"tilted", s.tilted},
                     {"turned", s.turned},
                     {"flipped", s.flipped},
                     {"joint_deg", s.joint_deg},
@@ -349,7 +369,7 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
   std::ostringstream out;
   out << std::left << std::setw(22) << "setting" << std::right << std::setw(10) << "detected" << std::setw(10)
       << "joint_deg" << std::setw(10) << "wrist_deg" << std::setw(12) << "keypoint_mm" << std::setw(12) << "keypoint_px"
-      << std::setw(11) << "camera_mm" << std::setw(8) << "jitter" << std::setw(8) << "ms" << std::setw(8) << "2turns" << std::setw(8) << "turned" << std::setw(8) << "flipped" << std::setw(5) << "lag" << "\n";
+      << std::setw(11) << "camera_mm" << std::setw(8) << "jitter" << std::setw(8) << "ms" << std::setw(8) << "2turns" << std::setw(8) << "tilted" << std::setw(8) << "turned" << std::setw(8) << "flipped" << std::setw(5) << "lag" << "\n";
   out << std::fixed;
   for (const EstimatorScore& s : scores) {
     out << std::left << std::setw(22) << s.name << std::right << std::setw(10)
@@ -357,7 +377,8 @@ std::string FormatTable(const std::vector<EstimatorScore>& scores) {
         << s.joint_deg << std::setw(10) << s.wrist_deg << std::setprecision(1) << std::setw(12) << s.keypoint_mm
         << std::setw(12) << s.keypoint_px << std::setw(11) << s.camera_mm << std::setw(8) << s.jitter_mm
         << std::setprecision(2) << std::setw(8) << s.ms_median << std::setprecision(0) << std::setw(7)
-        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%" << std::setw(8) << s.turned << std::setw(8) << s.flipped << std::setw(5) << (s.lag_frames.has_value() ? std::to_string(*s.lag_frames) : "-") << "\n";
+        << (s.detected > 0 ? 100.0 * s.both_turns / s.detected : 0.0) << "%" << std::setw(7)
+        << (s.detected > 0 ? 100.0 * s.tilted / s.detected : 0.0) << "%" << std::setw(8) << s.turned << std::setw(8) << s.flipped << std::setw(5) << (s.lag_frames.has_value() ? std::to_string(*s.lag_frames) : "-") << "\n";
   }
   return out.str();
 }

@@ -56,6 +56,7 @@ struct EstimatorScore {
   int frames = 0;
   int detected = 0;            // frames with an estimate
   int both_turns = 0;          // of which searched the half-turned crop too
+  int tilted = 0;              // of which searched the crop's tilts too (EstimatorOptions::tilts_deg)
   int turned = 0;              // of which with the wrist turned about a half turn: at least kTurnedDeg from the truth
   int flipped = 0;             // of which, the truth not edge-on, with the other side of the hand towards the camera (FacingOf)
   double joint_deg = 0.0;      // mean absolute joint-angle error, mean over detected frames

@@ -165,4 +165,21 @@ HandCrop HalfTurn(const HandCrop& crop) {
   return turned;
 }
 
+HandCrop TiltCrop(const HandCrop& crop, double angle) {
+  HandCrop tilted = crop;
+  const double centre = (crop.image.cols - 1) / 2.0;
+  // OpenCV's positive angle turns counter-clockwise as displayed (y down).
+  const cv::Mat turn = cv::getRotationMatrix2D(cv::Point2d(centre, centre), angle * 180.0 / std::numbers::pi, 1.0);
+  tilted.image = cv::Mat();
+  cv::warpAffine(crop.image, tilted.image, turn, crop.image.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+  tilted.roll = std::remainder(crop.roll + angle, 2.0 * std::numbers::pi);
+  const cv::Matx23d t(turn);
+  for (int r = 0; r < 2; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      tilted.crop_from_image(r, c) = t(r, 0) * crop.crop_from_image(0, c) + t(r, 1) * crop.crop_from_image(1, c) + (c == 2 ? t(r, 2) : 0.0);
+    }
+  }
+  return tilted;
+}
+
 }  // namespace nphand

@@ -56,4 +56,10 @@ std::optional<HandCrop> CropHand(const cv::Mat& mask, const CropOptions& options
 // ends look alike (small roll_skewness).
 HandCrop HalfTurn(const HandCrop& crop);
 
+// The crop turned by `angle` radians counter-clockwise (as displayed) about its centre
+// (bilinear; what leaves the square is lost, the corners it uncovers are empty): another
+// reading of a silhouette whose principal axis may be off, as stray pieces of a segmented
+// hand, a cut forearm or an object's hole turn it. Its roll and map follow the turn.
+HandCrop TiltCrop(const HandCrop& crop, double angle);
+
 }  // namespace nphand

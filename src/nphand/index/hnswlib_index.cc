@@ -7,6 +7,7 @@
 #include <mutex>
 #include <numeric>
 #include <optional>
+#include <queue>
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
@@ -280,19 +281,43 @@ class HnswlibIndex : public KnnIndex {
       return Rerank(set().descriptors, query, rows, static_cast<int>(kk));
     }
     std::vector<uint8_t> codes;
-    const float* row = query.data();
-    const void* graph_query = &row;
-    if (sq8_) {
-      codes.resize(query.size());
-      Encode(query, sq8_->step, codes.data());
-      graph_query = codes.data();
+    const float* row = nullptr;
+    return Found(graph_->searchKnn(GraphQuery(query, &codes, &row), kk));
+  }
+
+  // The 8-bit or float path only (an index through principal components searches as
+  // SearchRows does): hnswlib's greedy descent of the upper layers, then its base layer's
+  // search with a candidate list of max(effort, k), where searchKnn takes its ef_search.
+  std::vector<std::pair<float, uint32_t>> SearchRowsWithEffort(std::span<const float> query, int k, int effort) const override {
+    const size_t kk = std::min<size_t>(k, size());
+    if (kk == 0) return {};
+    if (options_.pca > 0) return SearchRows(query, k);
+    std::vector<uint8_t> codes;
+    const float* row = nullptr;
+    const void* graph_query = GraphQuery(query, &codes, &row);
+    const Graph& g = *graph_;
+    hnswlib::tableint node = g.enterpoint_node_;
+    float best = g.fstdistfunc_(graph_query, g.getDataByInternalId(node), g.dist_func_param_);
+    for (int level = g.maxlevel_; level > 0; --level) {
+      for (bool moved = true; moved;) {
+        moved = false;
+        unsigned int* links = g.get_linklist(node, level);
+        const hnswlib::tableint* next = reinterpret_cast<const hnswlib::tableint*>(links + 1);
+        for (int i = 0; i < g.getListCount(links); ++i) {
+          const float d = g.fstdistfunc_(graph_query, g.getDataByInternalId(next[i]), g.dist_func_param_);
+          if (d < best) {
+            best = d;
+            node = next[i];
+            moved = true;
+          }
+        }
+      }
     }
-    auto heap = graph_->searchKnn(graph_query, kk);
-    std::vector<std::pair<float, uint32_t>> found;
-    found.reserve(heap.size());
-    for (; !heap.empty(); heap.pop()) found.emplace_back(heap.top().first, static_cast<uint32_t>(heap.top().second));
-    std::sort(found.begin(), found.end());
-    return found;
+    auto candidates = g.searchBaseLayerST<false, false>(node, graph_query, std::max<size_t>(effort, kk));
+    while (candidates.size() > kk) candidates.pop();
+    std::priority_queue<std::pair<float, hnswlib::labeltype>> heap;
+    for (; !candidates.empty(); candidates.pop()) heap.emplace(candidates.top().first, g.getExternalLabel(candidates.top().second));
+    return Found(std::move(heap));
   }
 
   std::vector<uint8_t> Body() const override {
@@ -323,6 +348,25 @@ class HnswlibIndex : public KnnIndex {
   }
 
  private:
+  // hnswlib's result heap as rows, nearest first.
+  static std::vector<std::pair<float, uint32_t>> Found(std::priority_queue<std::pair<float, hnswlib::labeltype>> heap) {
+    std::vector<std::pair<float, uint32_t>> found;
+    found.reserve(heap.size());
+    for (; !heap.empty(); heap.pop()) found.emplace_back(heap.top().first, static_cast<uint32_t>(heap.top().second));
+    std::sort(found.begin(), found.end());
+    return found;
+  }
+
+  // What the graph measures a query by: its 8-bit codes (into `codes`) or, as hnswlib's
+  // float spaces take it, a pointer to the pointer `row` to its values.
+  const void* GraphQuery(std::span<const float> query, std::vector<uint8_t>* codes, const float** row) const {
+    *row = query.data();
+    if (!sq8_) return row;
+    codes->resize(query.size());
+    Encode(query, sq8_->step, codes->data());
+    return codes->data();
+  }
+
   void MakeGraph() {
     graph_ = std::make_unique<Graph>(space_.get(), std::max<size_t>(size(), 1), options_.m, options_.ef_construction,
                                      options_.seed);

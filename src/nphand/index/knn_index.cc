@@ -63,8 +63,23 @@ KnnIndex::KnnIndex(IndexedSet set) : set_(std::move(set)) {
 Neighbours KnnIndex::Search(const Descriptor& query, int k) const {
   NPHAND_THROW_CHECK(k >= 1, "search: k must be at least 1, not ", k);
   CheckQuery(config(), query);
+  return NeighboursOf(SearchRows(query.values, k));
+}
+
+Neighbours KnnIndex::Search(const Descriptor& query, int k, int effort) const {
+  NPHAND_THROW_CHECK(k >= 1, "search: k must be at least 1, not ", k);
+  NPHAND_THROW_CHECK(effort >= 1, "search: the effort must be at least 1, not ", effort);
+  CheckQuery(config(), query);
+  return NeighboursOf(SearchRowsWithEffort(query.values, k, effort));
+}
+
+std::vector<std::pair<float, uint32_t>> KnnIndex::SearchRowsWithEffort(std::span<const float> query, int k, int) const {
+  return SearchRows(query, k);
+}
+
+Neighbours KnnIndex::NeighboursOf(const std::vector<std::pair<float, uint32_t>>& rows) const {
   Neighbours neighbours;
-  for (const auto& [distance, row] : SearchRows(query.values, k)) {
+  for (const auto& [distance, row] : rows) {
     neighbours.ids.push_back(set_.ids[row]);
     neighbours.distances.push_back(distance);
   }

@@ -67,6 +67,10 @@ class KnnIndex {
   // The k nearest entries of `query` (all of them when the index holds fewer). Throws
   // nphand::Error, naming both configs, when the query was described differently.
   Neighbours Search(const Descriptor& query, int k) const;
+  // The same with less effort where the backend has a measure of it: hnswlib's candidate
+  // list is `effort` (at least k) instead of its ef_search. The other backends search as
+  // Search does. Throws as Search, and for an effort under 1.
+  Neighbours Search(const Descriptor& query, int k, int effort) const;
   // The squared distances from `query` to the entries `ids` (each one the index holds), as
   // its search measures them (an index of 8-bit codes by the codes), into `out`. False,
   // `out` untouched, for a backend that keeps nothing to measure with. Throws as Search.
@@ -89,12 +93,17 @@ class KnnIndex {
   const IndexedSet& set() const { return set_; }
   // The k nearest rows of the set: (squared distance, row), ascending, ties by row.
   virtual std::vector<std::pair<float, uint32_t>> SearchRows(std::span<const float> query, int k) const = 0;
+  // SearchRows with a candidate list of `effort` where the backend keeps one; this one
+  // ignores it.
+  virtual std::vector<std::pair<float, uint32_t>> SearchRowsWithEffort(std::span<const float> query, int k, int effort) const;
   // Distances for rows; this one measures the set's descriptor rows (false without them).
   virtual bool RowDistances(std::span<const float> query, std::span<const uint32_t> rows, float* out) const;
   // What the backend needs, beyond the set, to be loaded again.
   virtual std::vector<uint8_t> Body() const = 0;
 
  private:
+  // Rows (squared distance, row) as entries.
+  Neighbours NeighboursOf(const std::vector<std::pair<float, uint32_t>>& rows) const;
   IndexedSet set_;
   // By entry id, up to the largest the set holds: its row, or kNoRow. Distances looks up a
   // track's thousand-odd entries a frame; a binary search of the ids cost a quarter of a
