@@ -139,6 +139,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   estimator_options.skin.face_chroma = options.face_chroma;
   estimator_options.arm_agreement = options.arm_agreement;
   estimator_options.objects = options.objects;
+  estimator_options.tilts_deg = options.tilts_deg;
   const bool given = options.hand == "given";
   SetHandChoice(given ? "right" : options.hand, &estimator_options);
   Estimator right(db, index, hand, estimator_options);
@@ -165,6 +166,7 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["face_chroma"] = options.face_chroma;
   result.figures["arm_agreement"] = options.arm_agreement;
   result.figures["objects"] = options.objects;
+  result.figures["tilts_deg"] = options.tilts_deg;
   result.figures["given_box"] = options.given_box;
   result.figures["max_side"] = options.max_side;
   result.figures["machine"] = MachineDescription();

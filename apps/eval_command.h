@@ -94,6 +94,7 @@ struct EvalRealCommandOptions : EstimatorFiles {
   double face_chroma = SkinOptions{}.face_chroma;  // skin only near a face's colours while one is in view (0: off)
   double arm_agreement = EstimatorOptions{}.arm_agreement;  // hypotheses turned against the arm cut off weigh less
   bool objects = true;  // false: the hands hold nothing (EstimatorOptions::objects)
+  std::vector<double> tilts_deg = EstimatorOptions{}.tilts_deg;  // the crop's tilts where the match is poor
   // The hand's place given: each labelled hand estimated within its found region (the
   // pose alone judged, apart from finding the hand).
   bool given_box = false;
