@@ -56,11 +56,16 @@ constexpr const char* kArmAgreementHelp =
 constexpr const char* kNoObjectHelp =
     "The hand holds nothing (gestures, an empty hand): the database's views with an object are not weighed";
 
-// --tilts and --no-tilts of estimate, eval real and bench pipeline (EstimatorOptions::tilts_deg).
-constexpr const char* kTiltsHelp =
-    "Where the nearest view lies --tilt-above (estimate's; 0.6 by default) or farther, search the crop turned by plus "
-    "and minus each of these degrees too";
-constexpr const char* kNoTiltsHelp = "Never search the crop tilted";
+// --tilts and --no-tilts of estimate, eval real and bench pipeline (EstimatorOptions::tilts_deg):
+// one or the other.
+void AddTiltOptions(CLI::App* cmd, std::vector<double>& tilts_deg) {
+  CLI::Option* tilts = cmd->add_option("--tilts", tilts_deg,
+                                       "Where the nearest view lies --tilt-above (estimate's; 0.6 by default) or farther, search "
+                                       "the crop turned by plus and minus each of these degrees too")
+                           ->expected(1, 8)
+                           ->capture_default_str();
+  cmd->add_flag_callback("--no-tilts", [&tilts_deg] { tilts_deg.clear(); }, "Never search the crop tilted")->excludes(tilts);
+}
 
 // For options held in unsigned fields, which would take "-1" as a huge number.
 CLI::Validator WholeNumber() {
@@ -236,8 +241,7 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
   cmd->add_option("--roll-ambiguity", e.roll_ambiguity,
                   "Search the half-turned crop too when the silhouette's skewness is below this (0: never)")
       ->capture_default_str();
-  cmd->add_option("--tilts", e.tilts_deg, kTiltsHelp)->expected(1, 8)->capture_default_str();
-  cmd->add_flag_callback("--no-tilts", [&e] { e.tilts_deg.clear(); }, kNoTiltsHelp);
+  AddTiltOptions(cmd, e.tilts_deg);
   cmd->add_option("--tilt-above", e.tilt_above, "Search the crop's tilts where the nearest view lies this far or farther (0: on every frame)")
       ->capture_default_str();
   cmd->add_option("--focal", e.focal_px, "Focal length in pixels (0: from --fov)")->capture_default_str();
@@ -293,8 +297,7 @@ void AddBenchCommand(CLI::App& app, nphand::BenchRenderOptions& o, nphand::Bench
       ->capture_default_str();
   pipeline->add_option("--hand", p.hand, "right, left or auto (both sides searched)")->capture_default_str();
   pipeline->add_flag("--refine", p.refine, "Refine the best view's pose (its cost is ms.refine)");
-  pipeline->add_option("--tilts", p.tilts_deg, kTiltsHelp)->expected(1, 8)->capture_default_str();
-  pipeline->add_flag_callback("--no-tilts", [&p] { p.tilts_deg.clear(); }, kNoTiltsHelp);
+  AddTiltOptions(pipeline, p.tilts_deg);
   pipeline->add_flag("--face,!--no-face", p.face, "A face beside the hand in every frame (the face cascade and its skin gate timed too)")
       ->capture_default_str();
   pipeline->add_option("--seed", p.seed, "Seed of the rendered sequences")->check(WholeNumber())->capture_default_str();
@@ -521,8 +524,7 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
   cmd->add_option("--face-chroma", o.face_chroma, kFaceChromaHelp)->capture_default_str();
   cmd->add_option("--arm-agreement", o.arm_agreement, kArmAgreementHelp)->capture_default_str();
   cmd->add_flag("!--no-object", o.objects, kNoObjectHelp);
-  cmd->add_option("--tilts", o.tilts_deg, kTiltsHelp)->expected(1, 8)->capture_default_str();
-  cmd->add_flag_callback("--no-tilts", [&o] { o.tilts_deg.clear(); }, kNoTiltsHelp);
+  AddTiltOptions(cmd, o.tilts_deg);
   cmd->add_flag("--given-box", o.given_box,
                 "The hand's place given: each labelled hand estimated within its box grown by 25 % (its pose judged alone)");
   cmd->add_option("--max-side", o.max_side,

@@ -89,6 +89,7 @@ double Scale(const cv::Matx23d& a) { return std::sqrt(std::abs(a(0, 0) * a(1, 1)
 
 void MirrorResult(int width, FrameResult* r) {
   r->pose = MirrorPose(r->pose);
+  r->tilt_deg = -r->tilt_deg;
   for (Hypothesis& h : r->top) h.pose = MirrorPose(h.pose);
   for (int k = 0; k < kNumKeypoints; ++k) {
     r->keypoints_2d[k].x() = width - r->keypoints_2d[k].x();
@@ -711,7 +712,7 @@ struct Candidate {
 struct Estimator::Lookup {
   std::optional<cv::Point2d> arm;     // the forearm's direction, if one was cut off
   cv::Rect roi;                       // the hand's box, padded, within the frame
-  std::vector<HandCrop> crops;        // the crop, its half turn when its ends look alike, their tilts
+  std::vector<HandCrop> crops;        // the crop, its half turn when its ends look alike, the nearer one's tilts
   std::vector<int> half_of;           // per crop: 0 for the crop and its tilts, 1 for the half turn and its tilts
   size_t untilted = 1;                // crops before the tilts
   std::vector<Descriptor> descriptors;
@@ -755,11 +756,12 @@ void Estimator::Search(Lookup* lookup, FrameResult* result) {
   const Clock::time_point t = Clock::now();
   const double described = result->ms.describe;
   for (const Descriptor& d : lookup->descriptors) lookup->found.push_back(index_.Search(d, options_.k));
-  // A poor match: the crops turned a little each way too (their describing timed apart).
+  // A poor match (by the index's neighbours, before the track's views join them): the
+  // nearer turn's crop tilted a little each way too, their describing timed apart. Beyond
+  // max_distance the region is no hand, tilted or not.
   float nearest = std::numeric_limits<float>::infinity();
   for (const Neighbours& n : lookup->found) nearest = std::min(nearest, Nearest(n));
   const size_t searched = lookup->untilted = lookup->crops.size();
-  // (Beyond max_distance the region is no hand, tilted or not.)
   const double seen = std::sqrt(nearest);
   if (!options_.tilts_deg.empty() && db_.descriptor().normalize_roll && seen >= options_.tilt_above && seen <= options_.max_distance) {
     result->tilted = true;
@@ -849,15 +851,16 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     result->ms.weigh = Ms(t, Clock::now());
     return false;
   }
-  // Whether the region is a hand at all is judged by its own crop's matches: a tilt reads
-  // a hand's silhouette better, it does not make a region a hand.
+  // Whether the region is a hand at all is judged by its own crop's matches, and so is the
+  // nearest distance reported (--hand auto compares the sides by it): a tilt reads a hand's
+  // silhouette better, it does not make a region a hand, nor a side nearer.
   double nearest = hyp[0].distance, untilted = std::numeric_limits<double>::infinity();
   for (const Candidate& h : hyp) {
     nearest = std::min(nearest, h.distance);
     if (static_cast<size_t>(h.turn_of) < lookup->untilted) untilted = std::min(untilted, h.distance);
   }
   result->searched = true;
-  result->nearest_distance = nearest;
+  result->nearest_distance = untilted;
   if (untilted > options_.max_distance) {
     result->status = FrameStatus::kNotAHand;
     result->reason = "nothing in the database looks like this region (nearest feature distance " +

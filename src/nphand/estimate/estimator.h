@@ -79,8 +79,10 @@ struct EstimatorOptions {
   // 0.05 searches twice in a quarter of the frames (0.15: 58 %), for 0.2 mm more error and
   // 11-15 % more frames a second (docs/estimator.md).
   double roll_ambiguity = 0.05;
-  // Where the nearest view of the crop (and of its half turn) lies tilt_above or farther (0:
-  // every frame) but within max_distance, the crop (of the two turns, the nearer's) is
+  // Where the database's crops were turned by their principal axis (its descriptor's
+  // normalize_roll) and the nearest view the index finds for the crop (and for its half
+  // turn) lies tilt_above or farther (0: every frame) but within max_distance (a larger
+  // tilt_above: never), the crop (of the two turns, the nearer's) is
   // searched again turned by plus and minus each of tilts_deg: a segmented silhouette's
   // principal axis errs (a forearm's stump, an object's hole, stray skin beside it), where
   // the database's renders were turned by their own. Each turned crop's tilt_k nearest views
@@ -210,13 +212,13 @@ struct FrameResult {
   bool forearm_cut = false;
   bool both_turns = false;                     // the half-turned crop was searched too
   bool tilted = false;                         // the crop was searched turned too (EstimatorOptions::tilts_deg)
-  double tilt_deg = 0.0;                       // the turn of the crop the estimate came through (0: untilted)
+  double tilt_deg = 0.0;                       // the turn, counter-clockwise in the frame, of the crop the estimate came through (0: untilted)
   bool prior_used = false;                     // the temporal prior took part
   std::vector<Hypothesis> top;                 // the best top_n, best first
   std::vector<std::pair<std::string, double>> grasps;   // posterior over hand shapes (grasps, gestures), descending
   std::vector<std::pair<std::string, double>> objects;  // posterior over object shapes ("none": no object)
   bool searched = false;                       // the region was looked up in the database
-  double nearest_distance = 0.0;               // the best neighbour's feature distance (if searched)
+  double nearest_distance = 0.0;               // the best neighbour's feature distance (if searched), of the untilted crop
   double effective_samples = 0.0;              // 1 / sum w^2 over the hypotheses
   double confidence = 0.0;                     // the posterior mass near the best hypothesis, 0..1
   // Hypotheses of positive weight averaged into the estimate (EstimatorOptions::mode_mean;

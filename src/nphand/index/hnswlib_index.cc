@@ -313,6 +313,8 @@ class HnswlibIndex : public KnnIndex {
         }
       }
     }
+    // hnswlib 0.6's template arguments: no deletions, no metrics (later versions read them
+    // otherwise).
     auto candidates = g.searchBaseLayerST<false, false>(node, graph_query, std::max<size_t>(effort, kk));
     while (candidates.size() > kk) candidates.pop();
     std::priority_queue<std::pair<float, hnswlib::labeltype>> heap;

@@ -68,8 +68,9 @@ class KnnIndex {
   // nphand::Error, naming both configs, when the query was described differently.
   Neighbours Search(const Descriptor& query, int k) const;
   // The same with less effort where the backend has a measure of it: hnswlib's candidate
-  // list is `effort` (at least k) instead of its ef_search. The other backends search as
-  // Search does. Throws as Search, and for an effort under 1.
+  // list is `effort` (at least k) instead of its ef_search (but through principal
+  // components, where it re-ranks). The other backends search as Search does. Throws as
+  // Search, and for an effort under 1.
   Neighbours Search(const Descriptor& query, int k, int effort) const;
   // The squared distances from `query` to the entries `ids` (each one the index holds), as
   // its search measures them (an index of 8-bit codes by the codes), into `out`. False,
