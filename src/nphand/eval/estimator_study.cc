@@ -195,8 +195,8 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
   // neighbours and a fuller search of each.
   const std::vector<std::pair<std::string, std::vector<double>>> tilts = {
       {"none", {}}, {"10", {10.0}}, {"20", {20.0}}, {"30", {30.0}}, {"20-40", {20.0, 40.0}}, {"10-20-30", {10.0, 20.0, 30.0}}};
-  for (const auto& [name, degrees] : tilts) {
-    around_default("tilts-" + name, [&](EstimatorOptions& e) { e.tilts_deg = degrees; });
+  for (const auto& tilt : tilts) {
+    around_default("tilts-" + tilt.first, [&](EstimatorOptions& e) { e.tilts_deg = tilt.second; });
   }
   for (double above : {0.5, 0.55, 0.65, 0.7}) {
     std::ostringstream name;
