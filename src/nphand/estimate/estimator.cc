@@ -713,8 +713,10 @@ struct Estimator::Lookup {
   std::optional<cv::Point2d> arm;     // the forearm's direction, if one was cut off
   cv::Rect roi;                       // the hand's box, padded, within the frame
   std::vector<HandCrop> crops;        // the crop, its half turn when its ends look alike, the nearer one's tilts
-  std::vector<int> half_of;           // per crop: 0 for the crop and its tilts, 1 for the half turn and its tilts
   size_t untilted = 1;                // crops before the tilts
+  size_t tilted_from = 0;             // the crop the tilts turn
+  // The untilted crop that crop i is, or was tilted from: 0 the crop, 1 its half turn.
+  size_t HalfOf(size_t i) const { return i < untilted ? i : tilted_from; }
   std::vector<Descriptor> descriptors;
   std::vector<Neighbours> found;      // per crop
   std::vector<Candidate> hyp;
@@ -741,11 +743,7 @@ bool Estimator::Describe(const cv::Mat& hand_mask, cv::Rect box, cv::Size frame,
     return false;
   }
   lookup->crops = {*crop};
-  lookup->half_of = {0};
-  if (config.normalize_roll && crop->roll_skewness < options_.roll_ambiguity) {
-    lookup->crops.push_back(HalfTurn(*crop));
-    lookup->half_of.push_back(1);
-  }
+  if (config.normalize_roll && crop->roll_skewness < options_.roll_ambiguity) lookup->crops.push_back(HalfTurn(*crop));
   for (const HandCrop& c : lookup->crops) lookup->descriptors.push_back(DescribeCrop(c, config));
   result->both_turns = lookup->crops.size() == 2;
   result->ms.describe = Ms(t, Clock::now());
@@ -767,13 +765,11 @@ void Estimator::Search(Lookup* lookup, FrameResult* result) {
     result->tilted = true;
     // Of the two turns, the one whose nearest view is nearer (the other's tilts won no frame
     // of the validation sweep).
-    size_t c = 0;
-    if (searched == 2 && Nearest(lookup->found[1]) < Nearest(lookup->found[0])) c = 1;
+    const size_t c = lookup->tilted_from = searched == 2 && Nearest(lookup->found[1]) < Nearest(lookup->found[0]) ? 1 : 0;
     for (double tilt : options_.tilts_deg) {
       for (double sign : {-1.0, 1.0}) {
         const Clock::time_point d = Clock::now();
         lookup->crops.push_back(TiltCrop(lookup->crops[c], sign * tilt * std::numbers::pi / 180.0));
-        lookup->half_of.push_back(lookup->half_of[c]);
         lookup->descriptors.push_back(DescribeCrop(lookup->crops.back(), db_.descriptor()));
         result->ms.describe += Ms(d, Clock::now());
         lookup->found.push_back(index_.Search(lookup->descriptors.back(), options_.tilt_k, options_.tilt_effort));
@@ -1037,7 +1033,7 @@ std::optional<Estimator::EntryPlacement> Estimator::Refine(const Lookup& lookup,
     // replaces the lookup's best only if the silhouette agrees with it better and it is no
     // farther from the last frame's rotation.
     for (size_t i : lookup.order) {
-      if (lookup.half_of[lookup.hyp[i].turn_of] == lookup.half_of[best.turn_of]) continue;
+      if (lookup.HalfOf(lookup.hyp[i].turn_of) == lookup.HalfOf(best.turn_of)) continue;
       Tried other = attempt(lookup.hyp[i]);
       if (other.r.disagreement_after < chosen.r.disagreement_after && other.from_last <= chosen.from_last) chosen = std::move(other);
       break;
@@ -1132,7 +1128,7 @@ FrameResult Estimator::Estimate(const cv::Mat& hand_mask, cv::Rect box, cv::Size
   double turn = 0.0;
   int crop = 0;
   std::optional<EntryPlacement> placed = Refine(lookup, &turn, &crop, &result);
-  result.tilt_deg = std::remainder(lookup.crops[crop].roll - lookup.crops[lookup.half_of[crop]].roll, 2.0 * std::numbers::pi) /
+  result.tilt_deg = std::remainder(lookup.crops[crop].roll - lookup.crops[lookup.HalfOf(crop)].roll, 2.0 * std::numbers::pi) /
                     (std::numbers::pi / 180.0);
   if (!placed.has_value() && lookup.mean.has_value()) {
     // The mode's mean, placed through the best's crop.

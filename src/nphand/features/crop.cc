@@ -165,6 +165,13 @@ HandCrop HalfTurn(const HandCrop& crop) {
   return turned;
 }
 
+cv::Matx23d Compose(const cv::Matx23d& a, const cv::Matx23d& b) {
+  const cv::Matx33d a3(a(0, 0), a(0, 1), a(0, 2), a(1, 0), a(1, 1), a(1, 2), 0, 0, 1);
+  const cv::Matx33d b3(b(0, 0), b(0, 1), b(0, 2), b(1, 0), b(1, 1), b(1, 2), 0, 0, 1);
+  const cv::Matx33d c = a3 * b3;
+  return cv::Matx23d(c(0, 0), c(0, 1), c(0, 2), c(1, 0), c(1, 1), c(1, 2));
+}
+
 HandCrop TiltCrop(const HandCrop& crop, double angle) {
   HandCrop tilted = crop;
   const double centre = (crop.image.cols - 1) / 2.0;
@@ -173,12 +180,7 @@ HandCrop TiltCrop(const HandCrop& crop, double angle) {
   tilted.image = cv::Mat();
   cv::warpAffine(crop.image, tilted.image, turn, crop.image.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
   tilted.roll = std::remainder(crop.roll + angle, 2.0 * std::numbers::pi);
-  const cv::Matx23d t(turn);
-  for (int r = 0; r < 2; ++r) {
-    for (int c = 0; c < 3; ++c) {
-      tilted.crop_from_image(r, c) = t(r, 0) * crop.crop_from_image(0, c) + t(r, 1) * crop.crop_from_image(1, c) + (c == 2 ? t(r, 2) : 0.0);
-    }
-  }
+  tilted.crop_from_image = Compose(cv::Matx23d(turn), crop.crop_from_image);
   return tilted;
 }
 

@@ -56,6 +56,9 @@ std::optional<HandCrop> CropHand(const cv::Mat& mask, const CropOptions& options
 // ends look alike (small roll_skewness).
 HandCrop HalfTurn(const HandCrop& crop);
 
+// The affine map of 2 x 3 matrices a after b.
+cv::Matx23d Compose(const cv::Matx23d& a, const cv::Matx23d& b);
+
 // The crop turned by `angle` radians counter-clockwise (as displayed) about its centre
 // (bilinear; what leaves the square is lost, the corners it uncovers are empty): another
 // reading of a silhouette whose principal axis may be off, as stray pieces of a segmented

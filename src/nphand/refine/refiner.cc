@@ -71,14 +71,6 @@ RefineOptions PlaceOnly(RefineOptions options) {
   return options;
 }
 
-// The affine map of 2 x 3 matrices a after b.
-cv::Matx23d Compose(const cv::Matx23d& a, const cv::Matx23d& b) {
-  const cv::Matx33d a3(a(0, 0), a(0, 1), a(0, 2), a(1, 0), a(1, 1), a(1, 2), 0, 0, 1);
-  const cv::Matx33d b3(b(0, 0), b(0, 1), b(0, 2), b(1, 0), b(1, 1), b(1, 2), 0, 0, 1);
-  const cv::Matx33d c = a3 * b3;
-  return cv::Matx23d(c(0, 0), c(0, 1), c(0, 2), c(1, 0), c(1, 1), c(1, 2));
-}
-
 }  // namespace
 
 bool RefineOptions::Check(std::string* why) const {
