@@ -330,6 +330,44 @@ TEST(SkinTest, AFaceIsLookedForAgainWhileTheHandIsOverIt) {
   EXPECT_TRUE(looks(false).empty());
 }
 
+// Between full looks (every kFullLooks-th periodic one), a look seeks faces about as wide as
+// a face followed in the region it looks at: it finds that face again, box and all, as it
+// comes nearer, but a small face in the same region waits for the full look.
+TEST(SkinTest, ALookBetweenFullOnesSeeksFacesOfTheFollowedOnesSize) {
+  SkinOptions options;
+  options.face_interval = 2;  // looks at frames 0, 2, 4, 6 and 8; full at 0 and 8
+  SkinSegmenter segmenter(options);
+  const cv::Mat wall = MakeBackground(BackgroundKind::kClutter, cv::Size(640, 480), 3);
+  const cv::Vec3f skin = SkinToneByName("olive").bgr;
+  // The large face, `height` pixels tall; with `child`, a small face joined to its region by
+  // a skin-coloured shoulder.
+  auto scene = [&](int height, bool child) {
+    cv::Mat frame = wall.clone();
+    if (child) {
+      cv::rectangle(frame, cv::Rect(300, 330, 260, 150), cv::Scalar(skin[0], skin[1], skin[2]), cv::FILLED);
+      DrawFace(skin, cv::Point(500, 280), 90, &frame);
+    }
+    DrawFace(skin, cv::Point(260, 220), height, &frame);
+    return frame;
+  };
+  const SkinSegmentation first = segmenter.Segment(scene(180, false));
+  ASSERT_TRUE(first.faces_looked);
+  ASSERT_EQ(first.faces.size(), 1u);
+  EXPECT_FALSE(segmenter.Segment(scene(200, true)).faces_looked);
+  // Frame 2: the large face, nearer, found again with its new size; the small one not.
+  const SkinSegmentation banded = segmenter.Segment(scene(200, true));
+  ASSERT_TRUE(banded.faces_looked);
+  ASSERT_EQ(banded.faces.size(), 1u);
+  EXPECT_GT(banded.faces[0].width, first.faces[0].width * 21 / 20);
+  // A fresh segmenter's first look is full and finds both.
+  SkinSegmenter fresh(options);
+  EXPECT_EQ(fresh.Segment(scene(200, true)).faces.size(), 2u);
+  for (int f = 3; f < 8; ++f) EXPECT_EQ(segmenter.Segment(scene(200, true)).faces.size(), 1u) << f;
+  const SkinSegmentation full = segmenter.Segment(scene(200, true));
+  ASSERT_TRUE(full.faces_looked);
+  EXPECT_EQ(full.faces.size(), 2u);
+}
+
 // What the set-aside head leaves beside a face is a sliver (a cheek, the edge of a neck); a
 // region of a hand's size there (kInFrontShare of the face's box) stays a region. Here a
 // hand of the face's colour lies against its cheek, with no outline between them: the part

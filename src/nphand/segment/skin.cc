@@ -382,6 +382,8 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     return 2 * (face & hand).area() >= hand.area();
   });
   const bool look = periodic || newcomer_ || (hand_over_face && frames_ - last_look_ >= options_.face_relook);
+  // Every kFullLooks-th periodic look seeks faces of every size around the faces followed too.
+  const bool full = frames_ % (kFullLooks * options_.face_interval) == 0;
   if (look) last_look_ = frames_;
   ++frames_;
   // The cascade sees the frame halved until it is at most 320 pixels wide.
@@ -453,8 +455,28 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       for (int h = 0; h < halvings; ++h) cv::pyrDown(grey, grey);
       if (grey.cols < kMinFace || grey.rows < kMinFace) continue;
       cv::equalizeHist(grey, grey);
+      // Around a face followed here, a look between full ones seeks faces of its size only:
+      // it finds that face again (its box as it grows or shrinks); the small scales, which
+      // cost the most, wait for the next full look.
+      cv::Size least(kMinFace, kMinFace), most;
+      if (!full) {
+        int narrowest = 0, widest = 0;
+        for (const cv::Rect& face : followed) {
+          const cv::Rect at = working_box(face);
+          if (2 * (at & roi).area() < at.area()) continue;
+          const int side = at.width / look_scale;
+          narrowest = narrowest == 0 ? side : std::min(narrowest, side);
+          widest = std::max(widest, side);
+        }
+        if (widest > 0) {
+          const int low = std::max(kMinFace, static_cast<int>(kBandBelow * narrowest));
+          const int high = std::max(low, static_cast<int>(std::ceil(kBandAbove * widest)));
+          least = cv::Size(low, low);
+          most = cv::Size(high, high);
+        }
+      }
       std::vector<cv::Rect> found;
-      detector_->cascade.detectMultiScale(grey, found, 1.1, 4, 0, cv::Size(kMinFace, kMinFace));
+      detector_->cascade.detectMultiScale(grey, found, 1.1, 4, 0, least, most);
       for (const cv::Rect& f : found) {
         const cv::Rect face(roi.x * scale + f.x * to_frame, roi.y * scale + f.y * to_frame, f.width * to_frame,
                             f.height * to_frame);

@@ -51,7 +51,8 @@ struct SkinOptions {
   // such region's box of the frame before), around those regions, on the frame halved
   // until it is at most 320 pixels wide; between its runs each face found is followed (its
   // grey look where it was last seen matched around there); each face's head and neck are
-  // set aside from the skin.
+  // set aside from the skin. Around a face followed, a look seeks faces of about its size
+  // only, except every fourth periodic look, which seeks them all.
   std::string face_cascade = kDefaultFaceCascade;
   int face_interval = 30;
   // While the hand found last lies half or more within a face's box, the face is looked for
@@ -167,6 +168,10 @@ class SkinSegmenter {
   std::vector<cv::Mat> face_looks_;  // by face: its grey pixels where last seen, kFollowSide wide
   static constexpr int kFollowSide = 24;
   static constexpr double kFollowScore = 0.5;  // normalised correlation a followed face must reach
+  // Between full looks (every kFullLooks-th periodic one), the cascade seeks faces of
+  // kBandBelow to kBandAbove times the width of a face followed within its region.
+  static constexpr int kFullLooks = 4;
+  static constexpr double kBandBelow = 0.8, kBandAbove = 1.25;
   static constexpr double kInFrontShare = 0.15;  // least piece in front of a face, of its box
   static constexpr double kBodyWidths = 1.25;    // a body's least span along the frame's bottom edge, in faces
   static constexpr double kBodyPiece = 0.25;     // a body's piece's least width along that edge, in faces
