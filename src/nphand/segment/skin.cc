@@ -401,28 +401,53 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     cv::cvtColor(work(r), grey, cv::COLOR_BGR2GRAY);
     return grey;
   };
-  // Follows face i: its grey look where it was last seen (kFollowSide pixels wide) matched
-  // around there, a face's side each way; where it matches it is the face's new place and
-  // look (a turned or nearer face changes its look a little each frame). False where it does
-  // not match (covered, or gone).
+  // Follows face i: its grey look (kFollowSide pixels wide) matched around where it was last
+  // seen, a face's side each way; where it matches it is the face's new place. False where
+  // it does not match (covered, or gone). The place is kept to a fraction of a working pixel
+  // (the match's peak by a parabola through it and its neighbours). The look is taken
+  // afresh there only when it matches less well than kRefreshScore (a turned, rolled or
+  // nearer face): taken at every match, each match's error would add up, and a face
+  // drifting by less than half a pixel of its look each frame (several of the frame's)
+  // would be left behind or run ahead of.
   auto follow = [&](size_t i) {
     cv::Rect& face = faces_[i];
+    FaceLook& look = face_looks_[i];
     const cv::Rect at = working_box(face);
-    const cv::Rect roi = cv::Rect(at.x - at.width, at.y - at.height, at.width * 3, at.height * 3) & whole;
+    const cv::Point corner(static_cast<int>(std::floor(look.corner.x)), static_cast<int>(std::floor(look.corner.y)));
+    const cv::Rect roi = cv::Rect(corner.x - at.width, corner.y - at.height, at.width * 3, at.height * 3) & whole;
     const double shrink = static_cast<double>(kFollowSide) / at.width;
     cv::Mat small;
     cv::resize(grey_of(roi), small, cv::Size(), shrink, shrink, cv::INTER_AREA);
-    const cv::Mat& looks = face_looks_[i];
-    if (small.cols < looks.cols || small.rows < looks.rows) return false;
+    if (small.cols < look.grey.cols || small.rows < look.grey.rows) return false;
     cv::Mat score;
-    cv::matchTemplate(small, looks, score, cv::TM_CCOEFF_NORMED);
+    cv::matchTemplate(small, look.grey, score, cv::TM_CCOEFF_NORMED);
     double best = 0.0;
     cv::Point where;
     cv::minMaxLoc(score, nullptr, &best, nullptr, &where);
     if (best < kFollowScore) return false;
-    face.x = (roi.x + static_cast<int>(std::lround(where.x / shrink))) * scale;
-    face.y = (roi.y + static_cast<int>(std::lround(where.y / shrink))) * scale;
-    small(cv::Rect(where, looks.size())).copyTo(face_looks_[i]);
+    // The vertex of the parabola through a peak and its neighbours, off the peak (within half
+    // a pixel).
+    auto vertex = [](float before, float peak, float after) {
+      const double curve = before - 2.0 * peak + after;
+      return curve < 0.0 ? std::clamp(0.5 * (before - after) / curve, -0.5, 0.5) : 0.0;
+    };
+    cv::Point2d peak(where);
+    if (where.x > 0 && where.x + 1 < score.cols) {
+      const float* row = score.ptr<float>(where.y);
+      peak.x += vertex(row[where.x - 1], row[where.x], row[where.x + 1]);
+    }
+    if (where.y > 0 && where.y + 1 < score.rows) {
+      peak.y += vertex(score.at<float>(where.y - 1, where.x), score.at<float>(where.y, where.x),
+                       score.at<float>(where.y + 1, where.x));
+    }
+    look.corner = cv::Point2d(roi.x + peak.x / shrink, roi.y + peak.y / shrink);
+    face.x = static_cast<int>(std::lround(look.corner.x)) * scale;
+    face.y = static_cast<int>(std::lround(look.corner.y)) * scale;
+    if (best < kRefreshScore) {
+      const cv::Size side = look.grey.size();
+      const cv::Point2f centre(static_cast<float>(peak.x + (side.width - 1) / 2.0), static_cast<float>(peak.y + (side.height - 1) / 2.0));
+      cv::getRectSubPix(small, side, centre, look.grey);
+    }
     return true;
   };
   if (detector_ != nullptr && look) {
@@ -431,7 +456,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     // The faces followed so far that still match where they were: the cascade misses a face
     // a hand covers in part, and such a face is kept.
     std::vector<cv::Rect> followed;
-    std::vector<cv::Mat> followed_looks;
+    std::vector<FaceLook> followed_looks;
     for (size_t i = 0; i < faces_.size(); ++i) {
       if (!follow(i)) continue;
       followed.push_back(faces_[i]);
@@ -490,9 +515,10 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     face_looks_.clear();
     for (const cv::Rect& face : faces_) {
       const cv::Rect at = working_box(face) & whole;
-      cv::Mat looks;
-      cv::resize(grey_of(at), looks, cv::Size(kFollowSide, kFollowSide * at.height / std::max(1, at.width)), 0.0, 0.0, cv::INTER_AREA);
-      face_looks_.push_back(looks);
+      FaceLook look;
+      cv::resize(grey_of(at), look.grey, cv::Size(kFollowSide, kFollowSide * at.height / std::max(1, at.width)), 0.0, 0.0, cv::INTER_AREA);
+      look.corner = at.tl();
+      face_looks_.push_back(std::move(look));
     }
     for (size_t i = 0; i < followed.size(); ++i) {
       const cv::Rect& face = followed[i];

@@ -165,9 +165,14 @@ class SkinSegmenter {
   bool newcomer_ = false;             // one of them met none of the frame before's
   int last_look_ = 0;                 // the frame the cascade last ran on
   std::vector<cv::Rect> faces_;
-  std::vector<cv::Mat> face_looks_;  // by face: its grey pixels where last seen, kFollowSide wide
+  struct FaceLook {
+    cv::Mat grey;        // its grey pixels where last seen, kFollowSide wide
+    cv::Point2d corner;  // its box's top-left corner there, working pixels (to a fraction of one)
+  };
+  std::vector<FaceLook> face_looks_;  // by face
   static constexpr int kFollowSide = 24;
   static constexpr double kFollowScore = 0.5;  // normalised correlation a followed face must reach
+  static constexpr double kRefreshScore = 0.8;  // below it, a followed face's look is taken afresh
   // Between full looks (every kFullLooks-th periodic one), the cascade seeks faces of
   // kBandBelow to kBandAbove times the width of a face followed within its region.
   static constexpr int kFullLooks = 4;
