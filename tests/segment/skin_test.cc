@@ -1,5 +1,7 @@
 #include "nphand/segment/skin.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -303,6 +305,30 @@ TEST(SkinTest, AFaceDriftingSlowlyIsFollowed) {
   }
 }
 
+// A face that comes nearer as it drifts (here 1.5 % larger and 2 pixels across a frame)
+// matches its look less well each frame; below kRefreshScore the look is taken afresh where
+// it matched, and the face is followed on.
+TEST(SkinTest, AFaceComingNearerIsFollowedOn) {
+  SkinSegmenter segmenter(LookingAtFirst());
+  const cv::Mat wall = MakeBackground(BackgroundKind::kClutter, cv::Size(640, 480), 3);
+  const cv::Vec3f skin = SkinToneByName("olive").bgr;
+  auto face = [&](int frame) {
+    cv::Mat image = wall.clone();
+    DrawFace(skin, cv::Point(260 + 2 * frame, 220), static_cast<int>(std::lround(150 * std::pow(1.015, frame))), &image);
+    return image;
+  };
+  const SkinSegmentation first = segmenter.Segment(face(0));
+  ASSERT_EQ(first.faces.size(), 1u);
+  const int width = first.faces[0].width;
+  for (int frame = 1; frame <= 30; ++frame) {
+    const SkinSegmentation next = segmenter.Segment(face(frame));
+    EXPECT_FALSE(next.faces_looked);
+    ASSERT_EQ(next.faces.size(), 1u);
+    const double centre = next.faces[0].x + width / 2.0 - (first.faces[0].x + width / 2.0);
+    EXPECT_NEAR(centre, 2.0 * frame, 10.0) << frame;
+  }
+}
+
 // A face the cascade misses at a look, because a hand covers its eyes, is kept while its
 // look still matches where it was; one that is gone is dropped at the look.
 TEST(SkinTest, AFaceCoveredAtALookIsKeptWhileItStillMatches) {
@@ -379,10 +405,15 @@ TEST(SkinTest, ALookBetweenFullOnesSeeksFacesOfTheFollowedOnesSize) {
     DrawFace(skin, cv::Point(260, 220), height, &frame);
     return frame;
   };
+  // The two faces' skin is one region (what the looks search around).
+  SkinSegmenter faceless(NoFaces());
+  const SkinSegmentation joined = faceless.Segment(scene(200, true));
+  ASSERT_FALSE(joined.regions.empty());
+  EXPECT_TRUE(joined.regions[0].box.contains(cv::Point(260, 220)) && joined.regions[0].box.contains(cv::Point(500, 280)));
   const SkinSegmentation first = segmenter.Segment(scene(180, false));
   ASSERT_TRUE(first.faces_looked);
   ASSERT_EQ(first.faces.size(), 1u);
-  EXPECT_FALSE(segmenter.Segment(scene(200, true)).faces_looked);
+  segmenter.Segment(scene(200, true));
   // Frame 2: the large face, nearer, found again with its new size; the small one not.
   const SkinSegmentation banded = segmenter.Segment(scene(200, true));
   ASSERT_TRUE(banded.faces_looked);
@@ -395,6 +426,22 @@ TEST(SkinTest, ALookBetweenFullOnesSeeksFacesOfTheFollowedOnesSize) {
   const SkinSegmentation full = segmenter.Segment(scene(200, true));
   ASSERT_TRUE(full.faces_looked);
   EXPECT_EQ(full.faces.size(), 2u);
+  // A face followed while it grew past the band (1.5 times as wide over 8 frames) is not
+  // found at its old size at the next look: its region is then searched at every size.
+  SkinOptions every_eight = options;
+  every_eight.face_interval = 8;  // looks at frames 0 (full) and 8
+  SkinSegmenter grown(every_eight);
+  const SkinSegmentation small = grown.Segment(scene(140, false));
+  ASSERT_EQ(small.faces.size(), 1u);
+  for (int f = 1; f < 8; ++f) {
+    const SkinSegmentation s = grown.Segment(scene(static_cast<int>(std::lround(140 * std::pow(1.052, f))), false));
+    ASSERT_EQ(s.faces.size(), 1u) << f;
+    EXPECT_EQ(s.faces[0].width, small.faces[0].width) << f;  // a follow keeps the size
+  }
+  const SkinSegmentation again = grown.Segment(scene(210, false));
+  ASSERT_TRUE(again.faces_looked);
+  ASSERT_EQ(again.faces.size(), 1u);
+  EXPECT_GT(again.faces[0].width, small.faces[0].width * 13 / 10);
 }
 
 // What the set-aside head leaves beside a face is a sliver (a cheek, the edge of a neck); a

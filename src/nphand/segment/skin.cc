@@ -383,7 +383,7 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   });
   const bool look = periodic || newcomer_ || (hand_over_face && frames_ - last_look_ >= options_.face_relook);
   // Every kFullLooks-th periodic look seeks faces of every size around the faces followed too.
-  const bool full = frames_ % (kFullLooks * options_.face_interval) == 0;
+  const bool full = periodic && (frames_ / options_.face_interval) % kFullLooks == 0;
   if (look) last_look_ = frames_;
   ++frames_;
   // The cascade sees the frame halved until it is at most 320 pixels wide.
@@ -411,24 +411,24 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
   // would be left behind or run ahead of.
   auto follow = [&](size_t i) {
     cv::Rect& face = faces_[i];
-    FaceLook& look = face_looks_[i];
+    FaceLook& seen = face_looks_[i];
     const cv::Rect at = working_box(face);
-    const cv::Point corner(static_cast<int>(std::floor(look.corner.x)), static_cast<int>(std::floor(look.corner.y)));
+    const cv::Point corner(static_cast<int>(std::floor(seen.corner.x)), static_cast<int>(std::floor(seen.corner.y)));
     const cv::Rect roi = cv::Rect(corner.x - at.width, corner.y - at.height, at.width * 3, at.height * 3) & whole;
     const double shrink = static_cast<double>(kFollowSide) / at.width;
     cv::Mat small;
     cv::resize(grey_of(roi), small, cv::Size(), shrink, shrink, cv::INTER_AREA);
-    if (small.cols < look.grey.cols || small.rows < look.grey.rows) return false;
+    if (small.cols < seen.grey.cols || small.rows < seen.grey.rows) return false;
     cv::Mat score;
-    cv::matchTemplate(small, look.grey, score, cv::TM_CCOEFF_NORMED);
+    cv::matchTemplate(small, seen.grey, score, cv::TM_CCOEFF_NORMED);
     double best = 0.0;
     cv::Point where;
     cv::minMaxLoc(score, nullptr, &best, nullptr, &where);
     if (best < kFollowScore) return false;
     // The vertex of the parabola through a peak and its neighbours, off the peak (within half
     // a pixel).
-    auto vertex = [](float before, float peak, float after) {
-      const double curve = before - 2.0 * peak + after;
+    auto vertex = [](float before, float top, float after) {
+      const double curve = before - 2.0 * top + after;
       return curve < 0.0 ? std::clamp(0.5 * (before - after) / curve, -0.5, 0.5) : 0.0;
     };
     cv::Point2d peak(where);
@@ -440,13 +440,14 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       peak.y += vertex(score.at<float>(where.y - 1, where.x), score.at<float>(where.y, where.x),
                        score.at<float>(where.y + 1, where.x));
     }
-    look.corner = cv::Point2d(roi.x + peak.x / shrink, roi.y + peak.y / shrink);
-    face.x = static_cast<int>(std::lround(look.corner.x)) * scale;
-    face.y = static_cast<int>(std::lround(look.corner.y)) * scale;
+    seen.corner = cv::Point2d(roi.x + peak.x / shrink, roi.y + peak.y / shrink);
+    face.x = static_cast<int>(std::lround(seen.corner.x * scale));
+    face.y = static_cast<int>(std::lround(seen.corner.y * scale));
     if (best < kRefreshScore) {
-      const cv::Size side = look.grey.size();
-      const cv::Point2f centre(static_cast<float>(peak.x + (side.width - 1) / 2.0), static_cast<float>(peak.y + (side.height - 1) / 2.0));
-      cv::getRectSubPix(small, side, centre, look.grey);
+      const cv::Size side = seen.grey.size();
+      const cv::Point2f centre(static_cast<float>(peak.x + (side.width - 1) / 2.0),
+                               static_cast<float>(peak.y + (side.height - 1) / 2.0));
+      cv::getRectSubPix(small, side, centre, seen.grey);
     }
     return true;
   };
@@ -482,7 +483,8 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       cv::equalizeHist(grey, grey);
       // Around a face followed here, a look between full ones seeks faces of its size only:
       // it finds that face again (its box as it grows or shrinks); the small scales, which
-      // cost the most, wait for the next full look.
+      // cost the most, wait for the next full look. Where it finds none (the face covered, or
+      // grown or shrunk past the band since the last look), every size is sought after all.
       cv::Size least(kMinFace, kMinFace), most;
       if (!full) {
         int narrowest = 0, widest = 0;
@@ -502,6 +504,9 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
       }
       std::vector<cv::Rect> found;
       detector_->cascade.detectMultiScale(grey, found, 1.1, 4, 0, least, most);
+      if (found.empty() && most.area() > 0) {
+        detector_->cascade.detectMultiScale(grey, found, 1.1, 4, 0, cv::Size(kMinFace, kMinFace));
+      }
       for (const cv::Rect& f : found) {
         const cv::Rect face(roi.x * scale + f.x * to_frame, roi.y * scale + f.y * to_frame, f.width * to_frame,
                             f.height * to_frame);
@@ -515,10 +520,11 @@ SkinSegmentation SkinSegmenter::Segment(const cv::Mat& bgr, cv::Rect hand) {
     face_looks_.clear();
     for (const cv::Rect& face : faces_) {
       const cv::Rect at = working_box(face) & whole;
-      FaceLook look;
-      cv::resize(grey_of(at), look.grey, cv::Size(kFollowSide, kFollowSide * at.height / std::max(1, at.width)), 0.0, 0.0, cv::INTER_AREA);
-      look.corner = at.tl();
-      face_looks_.push_back(std::move(look));
+      FaceLook taken;
+      cv::resize(grey_of(at), taken.grey, cv::Size(kFollowSide, kFollowSide * at.height / std::max(1, at.width)), 0.0, 0.0,
+                 cv::INTER_AREA);
+      taken.corner = at.tl();
+      face_looks_.push_back(std::move(taken));
     }
     for (size_t i = 0; i < followed.size(); ++i) {
       const cv::Rect& face = followed[i];

@@ -50,7 +50,7 @@ struct SkinOptions {
   // frame after a skin region large enough to hold a face came into view (its box meets no
   // such region's box of the frame before), around those regions, on the frame halved
   // until it is at most 320 pixels wide; between its runs each face found is followed (its
-  // grey look where it was last seen matched around there); each face's head and neck are
+  // grey look, as last taken, matched around where it was last seen); each face's head and neck are
   // set aside from the skin. Around a face followed, a look seeks faces of about its size
   // only, except every fourth periodic look, which seeks them all.
   std::string face_cascade = kDefaultFaceCascade;
@@ -166,8 +166,8 @@ class SkinSegmenter {
   int last_look_ = 0;                 // the frame the cascade last ran on
   std::vector<cv::Rect> faces_;
   struct FaceLook {
-    cv::Mat grey;        // its grey pixels where last seen, kFollowSide wide
-    cv::Point2d corner;  // its box's top-left corner there, working pixels (to a fraction of one)
+    cv::Mat grey;        // its grey pixels, kFollowSide wide, as taken at a look or where a match fell below kRefreshScore
+    cv::Point2d corner;  // its box's top-left corner where it was last matched, working pixels (to a fraction of one)
   };
   std::vector<FaceLook> face_looks_;  // by face
   static constexpr int kFollowSide = 24;
