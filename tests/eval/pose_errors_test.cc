@@ -5,6 +5,7 @@
 #include "nphand/eval/pose_errors.h"
 
 #include <fstream>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -82,6 +83,27 @@ TEST_F(PoseErrorsTest, AnExactCopyHasNoErrorAndATurnedOneNoneAfterAlignment) {
   EXPECT_TRUE(json.contains("auc_0_50"));
   EXPECT_TRUE(json["per_frame"][0].contains("pa_mpjpe_mm"));
   EXPECT_NE(FormatTable(other).find("AUC 0-50 mm"), std::string::npos);
+}
+
+// A wrist 135 degrees or more from the truth's is turned about a half turn, and counted;
+// one 100 degrees off is merely wrong.
+TEST_F(PoseErrorsTest, AWristTurnedAboutAHalfTurnIsCounted) {
+  const auto dir = testing::ScratchDir();
+  std::vector<nlohmann::json> truth, poses;
+  for (int f = 0; f < 8; ++f) {
+    truth.push_back(Line(f, true, hands_[f]));
+    nlohmann::json line = Line(f, f != 7, hands_[f]);
+    const double deg = f < 3 ? 170.0 : f == 3 ? 135.5 : f == 4 ? 100.0 : 0.0;
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    if (f != 7) line["wrist_rotation"] = {{r(0, 0), r(0, 1), r(0, 2)}, {r(1, 0), r(1, 1), r(1, 2)}, {r(2, 0), r(2, 1), r(2, 2)}};
+    poses.push_back(line);
+  }
+  const PoseErrorSummary s = ComparePoses(Write(dir / "truth.jsonl", truth), Write(dir / "poses.jsonl", poses));
+  EXPECT_EQ(s.detected, 7);
+  EXPECT_EQ(s.turned, 4);
+  EXPECT_EQ(ToJson(s)["turned"], 4);
+  EXPECT_NE(FormatTable(s).find("half turn (135 degrees or more off) in 4 of 7 detected frames"), std::string::npos)
+      << FormatTable(s);
 }
 
 TEST_F(PoseErrorsTest, JitterSkipsTheGapsOfUndetectedFrames) {

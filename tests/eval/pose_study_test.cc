@@ -165,6 +165,12 @@ TEST_F(PoseStudyTest, TheEstimatorBeatsTheBaselinesAndNearsTheBound) {
   }
   EXPECT_EQ(bound.lag_frames, 0) << "the truth's nearest pose, frame by frame, does not trail it";
   EXPECT_EQ(ToJson(bound)["lag_frames"], 0);
+  // Frames turned about a half turn are counted: never the truth's nearest pose, but the mean
+  // pose, whose rotation is every view's average, often.
+  for (const MethodScore& s : scores) EXPECT_LE(s.turned, s.detected) << s.method;
+  EXPECT_EQ(bound.turned, 0);
+  EXPECT_EQ(ToJson(bound)["turned"], 0);
+  EXPECT_GT(Find(scores, "mean pose", "all", 0.0).turned, 0);
   for (const char* metric : {"pose", "keypoints"}) {
     const auto value = [&](const MethodScore& s) { return std::string(metric) == "pose" ? s.pose_error : s.keypoint_mm; };
     EXPECT_LE(value(bound), value(estimator)) << metric << ": the database's resolution bounds the estimator";

@@ -47,9 +47,6 @@ struct EstimatorStudyOptions {
 // sleeved, on each background, a face in every fourth.
 std::vector<SequenceOptions> ValidationSequences(const EstimatorStudyOptions& options);
 
-// A wrist this far from the truth is turned about 180 degrees: the wrist drawn at the
-// fingertips, a silhouette read end for end.
-inline constexpr double kTurnedDeg = 135.0;
 struct EstimatorScore {
   std::string name;
   nlohmann::json options;      // what differs from the base

@@ -42,6 +42,10 @@ double FractionWithin(std::span<const double> distances, double threshold);
 // none is within max. FreiHAND's AUC over 0–50 mm is AreaUnderCurve(d, 0.05).
 double AreaUnderCurve(std::span<const double> distances, double max, int steps = 100);
 
+// A wrist this far from the truth (degrees) is turned about 180 degrees: the wrist drawn at
+// the fingertips, a silhouette read end for end.
+inline constexpr double kTurnedDeg = 135.0;
+
 // Below this sine between the wrist->index MCP and wrist->little MCP rays a hand is edge-on:
 // which of its sides faces the camera is not judged.
 inline constexpr double kEdgeOnSine = 0.2;

@@ -105,6 +105,7 @@ PoseErrorSummary ComparePoses(const std::filesystem::path& truth_path, const std
         }
       }
       e.wrist_deg = RotationAngleDeg(a, b);
+      summary.turned += e.wrist_deg >= kTurnedDeg;
       const Points3 kh = Field<Points3>(p, "keypoints_3d_hand_m", poses_path, i);
       const Points3 kc = Field<Points3>(p, "keypoints_3d_camera_m", poses_path, i);
       const Points3 tc = Field<Points3>(t, "keypoints_3d_camera_m", truth_path, i);
@@ -215,6 +216,7 @@ nlohmann::json ToJson(const PoseErrorSummary& summary) {
           {"jitter_mm", JsonNumber(summary.jitter_mm)},
           {"truth_jitter_mm", JsonNumber(summary.truth_jitter_mm)},
           {"lag_frames", summary.lag_frames.has_value() ? nlohmann::json(*summary.lag_frames) : nlohmann::json(nullptr)},
+          {"turned", summary.turned},
           {"palm_back_judged", summary.palm_back_judged},
           {"palm_back_right", summary.palm_back_right},
           {"per_frame", frames}};
@@ -235,6 +237,8 @@ std::string FormatTable(const PoseErrorSummary& summary) {
       << (summary.lag_frames.has_value() ? std::to_string(*summary.lag_frames) + (*summary.lag_frames == 1 ? " frame" : " frames")
                                           : std::string("n/a"))
       << " (the shift of the truth, 0-" << kMaxLag << " frames back, at which the keypoints about the wrist agree best)\n";
+  out << "wrist turned about a half turn (" << kTurnedDeg << " degrees or more off) in " << summary.turned << " of "
+      << summary.detected << " detected frames\n";
   out << "palm or back towards the camera right in " << summary.palm_back_right << " of " << summary.palm_back_judged
       << " judged detected frames (the others edge-on or without a side)\n";
   return out.str();

@@ -47,6 +47,9 @@ struct PoseErrorSummary {
   double truth_jitter_mm = 0.0;
   // The estimate's lag behind the truth, frames (LagMeter, measures.h); none with nothing detected.
   std::optional<int> lag_frames;
+  // Detected frames with the wrist turned about a half turn: kTurnedDeg (measures.h) or more
+  // from the truth's.
+  int turned = 0;
   // Detected frames whose side towards the camera is judged, and those the estimate has right.
   int palm_back_judged = 0, palm_back_right = 0;
 };

@@ -32,6 +32,7 @@ nlohmann::json ToJson(const MethodScore& s) {
           {"keypoint_px", JsonNumber(s.keypoint_px)},
           {"joint_deg", JsonNumber(s.joint_deg)},
           {"wrist_deg", JsonNumber(s.wrist_deg)},
+          {"turned", s.turned},
           {"jitter_mm", JsonNumber(s.jitter_mm)},
           {"truth_jitter_mm", JsonNumber(s.truth_jitter_mm)},
           {"lag_frames", s.lag_frames.has_value() ? nlohmann::json(*s.lag_frames) : nlohmann::json(nullptr)},
@@ -46,7 +47,7 @@ std::string FormatScores(const std::vector<MethodScore>& scores, const std::stri
       << std::setw(9) << "no-hand"
       << std::setw(8) << "pose" << std::setw(7) << "/NN" << std::setw(9) << "kp_mm" << std::setw(7) << "/NN" << std::setw(8)
       << "PA_mm" << std::setw(7) << "<20mm" << std::setw(7) << "AUC" << std::setw(7) << "px" << std::setw(8) << "wrist"
-      << std::setw(8) << "jitter" << std::setw(5) << "lag" << std::setw(8) << "ms" << "\n";
+      << std::setw(7) << "turned" << std::setw(8) << "jitter" << std::setw(5) << "lag" << std::setw(8) << "ms" << "\n";
   out << std::fixed;
   auto cell = [&](double v, int width, int precision) {
     if (std::isfinite(v)) {
@@ -69,6 +70,7 @@ std::string FormatScores(const std::vector<MethodScore>& scores, const std::stri
     cell(s.auc_0_50, 7, 2);
     cell(s.keypoint_px, 7, 1);
     cell(s.wrist_deg, 8, 1);
+    out << std::setw(7) << s.turned;
     cell(s.jitter_mm, 8, 2);
     out << std::setw(5) << (s.lag_frames.has_value() ? std::to_string(*s.lag_frames) : "-");
     cell(s.ms_median, 8, 2);

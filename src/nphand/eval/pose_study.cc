@@ -64,6 +64,7 @@ MethodScore Summarise(const std::string& method, const std::string& sequence, do
       s.pa_mpjpe_mm += f.pa_mpjpe_mm;
       s.joint_deg += f.joint_deg;
       s.wrist_deg += f.wrist_deg;
+      s.turned += f.wrist_deg >= kTurnedDeg;
       if (!std::isnan(f.keypoint_px)) {
         px += f.keypoint_px;
         ++px_frames;

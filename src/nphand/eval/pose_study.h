@@ -88,6 +88,7 @@ struct MethodScore {
   double pa_mpjpe_mm = 0.0;        // after a similarity alignment
   double joint_deg = 0.0;          // mean absolute joint-angle error
   double wrist_deg = 0.0;          // wrist orientation
+  int turned = 0;                  // detected frames with the wrist turned about a half turn (kTurnedDeg or more from the truth)
   double keypoint_px = 0.0;        // 2D, in the frame; NaN for methods that do not place the hand
   // Over every keypoint of the detected frames.
   double within_20mm = 0.0;
