@@ -136,6 +136,8 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   estimator_options.track_views = options.track_views;
   estimator_options.carried = options.carried;
   estimator_options.carry_apart_frames = options.carry_apart_frames;
+  estimator_options.prior_reset_frames = options.prior_reset_frames;
+  estimator_options.prior_reset_margin = options.prior_reset_margin;
   estimator_options.skin.face_chroma = options.face_chroma;
   estimator_options.arm_agreement = options.arm_agreement;
   estimator_options.objects = options.objects;
@@ -163,6 +165,8 @@ EvalRealResult RunEvalReal(const EvalRealCommandOptions& options, std::ostream* 
   result.figures["track_views"] = options.track_views;
   result.figures["carried"] = options.carried;
   result.figures["carry_apart_frames"] = options.carry_apart_frames;
+  result.figures["prior_reset_frames"] = options.prior_reset_frames;
+  result.figures["prior_reset_margin"] = options.prior_reset_margin;
   result.figures["face_chroma"] = options.face_chroma;
   result.figures["arm_agreement"] = options.arm_agreement;
   result.figures["objects"] = options.objects;

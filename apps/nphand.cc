@@ -52,6 +52,13 @@ constexpr const char* kArmAgreementHelp =
     "Where a forearm was cut off, how much less a hypothesis weighs whose wrist is turned away from the arm "
     "(log weight per unit of disagreement; 0: the arm is not looked at)";
 
+// --prior-reset and --prior-reset-margin of estimate and eval real
+// (EstimatorOptions::prior_reset_frames, prior_reset_margin).
+constexpr const char* kPriorResetHelp =
+    "Let a track go when, this many frames in a row, the nearest view lies outside its mode and nearer than the "
+    "mode's own by --prior-reset-margin (0: never)";
+constexpr const char* kPriorResetMarginHelp = "How much nearer (feature distance) the view outside the track's mode must lie";
+
 // --no-object of estimate and eval real (EstimatorOptions::objects).
 constexpr const char* kNoObjectHelp =
     "The hand holds nothing (gestures, an empty hand): the database's views with an object are not weighed";
@@ -225,6 +232,8 @@ void AddEstimateCommand(CLI::App& app, nphand::EstimateCommandOptions& o) {
                   "In a track's first N frames, carry hypotheses at least --sigma-x apart in pose (one per mode; 0: never)")
       ->check(WholeNumber())
       ->capture_default_str();
+  cmd->add_option("--prior-reset", e.prior_reset_frames, kPriorResetHelp)->check(WholeNumber())->capture_default_str();
+  cmd->add_option("--prior-reset-margin", e.prior_reset_margin, kPriorResetMarginHelp)->capture_default_str();
   cmd->add_option("--top-n", e.top_n, "Hypotheses kept per frame")->capture_default_str();
   cmd->add_option("--mode-mean", e.mode_mean,
                   "The estimate: the weighted mean of the hypotheses within this pose distance of the best (0: the best alone)")
@@ -521,6 +530,8 @@ void AddEvalRealCommand(CLI::App* eval, nphand::EvalRealCommandOptions& o, bool&
                   "In a track's first N frames, carry hypotheses at least sigma_x apart in pose (one per mode; 0: never)")
       ->check(WholeNumber())
       ->capture_default_str();
+  cmd->add_option("--prior-reset", o.prior_reset_frames, kPriorResetHelp)->check(WholeNumber())->capture_default_str();
+  cmd->add_option("--prior-reset-margin", o.prior_reset_margin, kPriorResetMarginHelp)->capture_default_str();
   cmd->add_option("--face-chroma", o.face_chroma, kFaceChromaHelp)->capture_default_str();
   cmd->add_option("--arm-agreement", o.arm_agreement, kArmAgreementHelp)->capture_default_str();
   cmd->add_flag("!--no-object", o.objects, kNoObjectHelp);

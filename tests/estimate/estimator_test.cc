@@ -1176,6 +1176,55 @@ TEST_F(EstimatorTest, TheTracksViewsJoinTheNeighboursInATrack) {
   EXPECT_EQ(again[1].confidence, tracked[1].confidence);
 }
 
+// A hand that changes its grasp at once, seen from the same view: the track's views keep
+// its old grasp among the hypotheses, and with an observation weight flat enough (sigma_y
+// 2, where the default's 0.1 reads the new grasp at once) the product prior holds it
+// against the frames; with the reset, a few frames whose nearest view lies outside the
+// track's mode let the track go, and the new grasp is read.
+TEST_F(EstimatorTest, ATrackHeldAgainstTheFramesIsLetGo) {
+  const size_t a = EntryWithoutObject(*db_, 400);
+  size_t b = 0;
+  for (size_t e = 0; e < db_->size() && b == 0; ++e) {
+    if (db_->Meta(e).with_object || !db_->Meta(e).has_hand || db_->Meta(e).viewpoint != db_->Meta(a).viewpoint) continue;
+    double squares = 0.0;
+    for (int j = 0; j < kNumDofs; ++j) squares += std::pow(db_->Angles(e)[j] - db_->Angles(a)[j], 2);
+    if (std::sqrt(squares) > 1.5) b = e;
+  }
+  ASSERT_NE(b, 0u) << "no other grasp from entry " << a << "'s view";
+  const auto track = [&](int reset) {
+    EstimatorOptions options = Options();
+    options.sigma_y = 2.0;
+    options.prior_reset_frames = reset;
+    Estimator estimator(*db_, *index_, RightHand(), options);
+    const cv::Mat first = EntryHand(estimator, a), then = EntryHand(estimator, b);
+    std::vector<uint32_t> best;
+    for (int frame = 0; frame < 15; ++frame) {
+      const FrameResult r = estimator.ProcessMask(frame < 5 ? first : then, frame / 30.0);
+      EXPECT_TRUE(r.detected()) << frame << ": " << r.reason;
+      best.push_back(r.top.empty() ? 0 : r.top[0].entry);
+    }
+    return best;
+  };
+  EXPECT_EQ(EstimatorOptions{}.prior_reset_frames, 0) << "off by default";
+  const std::vector<uint32_t> held = track(0), let_go = track(3);
+  for (int frame = 0; frame < 5; ++frame) EXPECT_EQ(held[frame], a) << frame;
+  for (int frame = 5; frame < 15; ++frame) EXPECT_NE(held[frame], b) << frame << ": the prior holds the old grasp";
+  // Frames 5-7 count against the track, frame 8 starts afresh.
+  for (int frame = 0; frame < 8; ++frame) EXPECT_EQ(let_go[frame], held[frame]) << frame;
+  EXPECT_EQ(let_go[8], b);
+  // The new track then wanders within the new grasp's neighbourhood (the observation is
+  // flat), never back to the old one.
+  const auto from = [&](uint32_t e, size_t to) {
+    double squares = 0.0;
+    for (int j = 0; j < kNumDofs; ++j) squares += std::pow(db_->Angles(e)[j] - db_->Angles(to)[j], 2);
+    return std::sqrt(squares);
+  };
+  for (int frame = 9; frame < 15; ++frame) {
+    EXPECT_LT(from(let_go[frame], b), from(let_go[frame], a)) << frame << ": entry " << let_go[frame];
+    EXPECT_GT(from(let_go[frame], a), 1.0) << frame << ": entry " << let_go[frame];
+  }
+}
+
 // The crop is searched tilted where the nearest view lies tilt_above or farther (0: on
 // every frame), and then the clean view of an entry is still that entry, through the
 // untilted crop.

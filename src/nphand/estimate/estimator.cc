@@ -195,6 +195,8 @@ bool EstimatorOptions::Check(std::string* why) const {
     *why = "the track's views must be within 0..64";
   } else if (carry_apart_frames < 0) {
     *why = "the frames carrying hypotheses apart must be 0 or more";
+  } else if (prior_reset_frames < 0 || !(prior_reset_margin >= 0.0 && prior_reset_margin < 10.0)) {
+    *why = "the prior's reset must be after 0 or more frames, its margin within [0, 10)";
   } else if (carried < 1 || carried > k || top_n < 1 || top_n > k) {
     *why = "carried hypotheses and top-N must be within 1..k";
   } else if (!(mode_mean >= 0.0 && mode_mean < 10.0)) {
@@ -387,6 +389,7 @@ void Estimator::Reset() {
   refined_ = {};
   refined_before_ = {};
   track_start_ = {0, 0};
+  elsewhere_ = {0, 0};
   widths_.clear();
   held_width_.reset();
   ResetSmoothing();
@@ -917,6 +920,18 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     carried_sum += hyp[i].w;
   }
   for (WeightedPose& c : carried_) c.weight = carried_sum > 0.0 ? c.weight / carried_sum : 1.0 / carried_.size();
+  if (options_.prior_reset_frames > 0) {
+    double in_mode = std::numeric_limits<double>::infinity(), outside = in_mode;
+    for (const Candidate& h : hyp) {
+      double& nearest_of = (h.x - best.x).norm() <= 2.0 * options_.sigma_x ? in_mode : outside;
+      nearest_of = std::min(nearest_of, h.distance);
+    }
+    elsewhere_[side] = result->prior_used && in_mode - outside > options_.prior_reset_margin ? elsewhere_[side] + 1 : 0;
+    if (elsewhere_[side] >= options_.prior_reset_frames) {
+      carried_.clear();
+      elsewhere_[side] = 0;
+    }
+  }
 
   // Posteriors, confidence.
   // Summed by hand shape (grasp or gesture) and by object shape (the last slot: no object);

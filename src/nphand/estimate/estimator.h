@@ -62,6 +62,14 @@ struct EstimatorOptions {
   // first holds the estimate, where the lookup's first pick may lock a wrong one in
   // (0: never; docs/estimator.md).
   int carry_apart_frames = 0;
+  // Where, in a track, the nearest view lies outside the track's mode (farther than twice
+  // sigma_x in pose from the best) and nearer than the mode's own nearest by more than
+  // prior_reset_margin (feature distance), for prior_reset_frames frames in a row, the track
+  // starts afresh on the next frame: a mode the prior holds against the frames' evidence (a
+  // hand read end for end) is let go (0: never, the default: a small gain on the validation
+  // sweep, but a database of sparser views loses its tracks; docs/estimator.md).
+  int prior_reset_frames = 0;
+  double prior_reset_margin = 0.1;
   // The track's views: in a track, the entries seen from the `track_views` viewpoints
   // nearest the last frame's best (its own first) join the K neighbours, measured against the
   // frame's descriptor, so that the prior finds the views near its track even where an
@@ -409,6 +417,7 @@ class Estimator {
   static constexpr double kWidthFit = 0.15;
   std::vector<WeightedPose> carried_;
   std::array<int, 2> track_start_ = {0, 0};  // by side: the frame the track began (its first frame without the prior)
+  std::array<int, 2> elsewhere_ = {0, 0};    // by side: frames in a row the nearest view lay outside the track's mode
   // track_views: by viewpoint, the entries the index holds and the track_views nearest
   // viewpoints (itself first); per entry, the search that last found it.
   std::vector<std::vector<entry_id_t>> view_entries_;

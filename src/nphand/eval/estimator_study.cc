@@ -60,6 +60,18 @@ std::vector<EstimatorSetting> EstimatorSweep(const EstimatorOptions& base) {
   for (int carried : {20, 100}) {
     around_default("carried" + std::to_string(carried), [&](EstimatorOptions& e) { e.carried = carried; });
   }
+  // A track let go where the frames' nearest view lies outside its mode, clearly nearer, for
+  // this many frames in a row.
+  for (int frames : {3, 5, 10}) {
+    for (double margin : {0.05, 0.1}) {
+      std::ostringstream name;
+      name << "reset" << frames << "-m" << margin;
+      around_default(name.str(), [&](EstimatorOptions& e) {
+        e.prior_reset_frames = frames;
+        e.prior_reset_margin = margin;
+      });
+    }
+  }
   // The estimate as the mode's weighted mean: how far from the best its hypotheses may lie
   // (0: the best alone).
   for (double reach : {0.0, 0.25, 0.5, 1.0, 1.5, 2.0}) {
@@ -278,7 +290,9 @@ std::vector<EstimatorScore> RunEstimatorStudy(const Database& db, const KnnIndex
     score.name = setting.name;
     score.options = {{"k", e.k},           {"observation", ToString(e.observation)}, {"sigma_y", e.sigma_y},
                      {"prior", ToString(e.prior)}, {"sigma_x", e.sigma_x}, {"prior_share", e.prior_share},
-                     {"carried", e.carried},        {"carry_apart_frames", e.carry_apart_frames}, {"roll_ambiguity", e.roll_ambiguity},
+                     {"carried", e.carried},        {"carry_apart_frames", e.carry_apart_frames},
+                     {"prior_reset_frames", e.prior_reset_frames}, {"prior_reset_margin", e.prior_reset_margin},
+                     {"roll_ambiguity", e.roll_ambiguity},
                      {"tilts_deg", e.tilts_deg}, {"tilt_above", e.tilt_above}, {"tilt_k", e.tilt_k}, {"tilt_effort", e.tilt_effort},
                      {"mode_mean", e.mode_mean},       {"refine", RefinementJson(e)},
                      {"smooth", SmoothingJson(e)}};
