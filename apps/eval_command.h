@@ -92,7 +92,7 @@ struct EvalRealCommandOptions : EstimatorFiles {
   int carried = EstimatorOptions{}.carried;          // hypotheses carried to the next frame
   int carry_apart_frames = EstimatorOptions{}.carry_apart_frames;  // a track's first frames carry one hypothesis per mode
   int prior_reset_frames = EstimatorOptions{}.prior_reset_frames;  // a track let go after this many frames against it
-  double prior_reset_margin = EstimatorOptions{}.prior_reset_margin;
+  double prior_reset_margin = EstimatorOptions{}.prior_reset_margin;  // how much nearer the view outside the mode lies
   double face_chroma = SkinOptions{}.face_chroma;  // skin only near a face's colours while one is in view (0: off)
   double arm_agreement = EstimatorOptions{}.arm_agreement;  // hypotheses turned against the arm cut off weigh less
   bool objects = true;  // false: the hands hold nothing (EstimatorOptions::objects)

@@ -55,8 +55,9 @@ constexpr const char* kArmAgreementHelp =
 // --prior-reset and --prior-reset-margin of estimate and eval real
 // (EstimatorOptions::prior_reset_frames, prior_reset_margin).
 constexpr const char* kPriorResetHelp =
-    "Let a track go when, this many frames in a row, the nearest view lies outside its mode and nearer than the "
-    "mode's own by --prior-reset-margin (0: never, the default: real video lost more than it gained, docs/estimator.md)";
+    "With a prior, let a track go when, this many frames in a row, the nearest view lies outside its mode and nearer "
+    "than the mode's own by more than --prior-reset-margin (0: never, the default: real video lost more than it gained, "
+    "docs/estimator.md)";
 constexpr const char* kPriorResetMarginHelp = "How much nearer (feature distance) the view outside the track's mode must lie";
 
 // --no-object of estimate and eval real (EstimatorOptions::objects).

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <tuple>
 
@@ -1183,14 +1184,15 @@ TEST_F(EstimatorTest, TheTracksViewsJoinTheNeighboursInATrack) {
 // track's mode let the track go, and the new grasp is read.
 TEST_F(EstimatorTest, ATrackHeldAgainstTheFramesIsLetGo) {
   const size_t a = EntryWithoutObject(*db_, 400);
-  size_t b = 0;
-  for (size_t e = 0; e < db_->size() && b == 0; ++e) {
+  std::optional<size_t> other;
+  for (size_t e = 0; e < db_->size() && !other.has_value(); ++e) {
     if (db_->Meta(e).with_object || !db_->Meta(e).has_hand || db_->Meta(e).viewpoint != db_->Meta(a).viewpoint) continue;
     double squares = 0.0;
     for (int j = 0; j < kNumDofs; ++j) squares += std::pow(db_->Angles(e)[j] - db_->Angles(a)[j], 2);
-    if (std::sqrt(squares) > 1.5) b = e;
+    if (std::sqrt(squares) > 1.5) other = e;
   }
-  ASSERT_NE(b, 0u) << "no other grasp from entry " << a << "'s view";
+  ASSERT_TRUE(other.has_value()) << "no other grasp from entry " << a << "'s view";
+  const size_t b = *other;
   const auto track = [&](int reset) {
     EstimatorOptions options = Options();
     options.sigma_y = 2.0;
@@ -1356,6 +1358,12 @@ TEST_F(EstimatorTest, BadSetUpsAreRefused) {
   options = Options();
   options.carry_apart_frames = -1;
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "carrying hypotheses apart");
+  options = Options();
+  options.prior_reset_frames = -1;
+  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "the prior's reset");
+  options = Options();
+  options.prior_reset_margin = 10.0;
+  testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "its margin within [0, 10)");
   options = Options();
   options.tilts_deg = {15.0, 0.0};
   testing::ExpectError([&] { Estimator(*db_, *index_, RightHand(), options); }, "each tilt of the crop must be within (0, 90]");

@@ -49,6 +49,9 @@ TEST_F(EstimatorStudyTest, EverySettingIsNamedOnceAndVariesWhatItSays) {
   EXPECT_EQ(find("carried20").options.carried, 20);
   EXPECT_EQ(find("carry-apart30").options.carry_apart_frames, 30);
   EXPECT_EQ(EstimatorOptions{}.carry_apart_frames, 0);
+  EXPECT_EQ(find("reset3-m0.1").options.prior_reset_frames, 3);
+  EXPECT_EQ(find("reset3-m0.1").options.prior_reset_margin, 0.1);
+  EXPECT_EQ(find("reset10-m0.05").options.prior_reset_frames, 10);
   EXPECT_FALSE(find("nn").options.refine);
   EXPECT_TRUE(find("refine").options.refine);
   EXPECT_FALSE(find("refine").options.refinement.move_fingers);

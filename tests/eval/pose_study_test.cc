@@ -171,6 +171,7 @@ TEST_F(PoseStudyTest, TheEstimatorBeatsTheBaselinesAndNearsTheBound) {
   EXPECT_EQ(bound.turned, 0);
   EXPECT_EQ(ToJson(bound)["turned"], 0);
   EXPECT_GT(Find(scores, "mean pose", "all", 0.0).turned, 0);
+  EXPECT_NE(FormatScores(scores).find(" turned "), std::string::npos);
   for (const char* metric : {"pose", "keypoints"}) {
     const auto value = [&](const MethodScore& s) { return std::string(metric) == "pose" ? s.pose_error : s.keypoint_mm; };
     EXPECT_LE(value(bound), value(estimator)) << metric << ": the database's resolution bounds the estimator";

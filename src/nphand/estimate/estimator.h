@@ -66,8 +66,10 @@ struct EstimatorOptions {
   // sigma_x in pose from the best) and nearer than the mode's own nearest by more than
   // prior_reset_margin (feature distance), for prior_reset_frames frames in a row, the track
   // starts afresh on the next frame: a mode the prior holds against the frames' evidence (a
-  // hand read end for end) is let go (0: never, the default: a small gain on the validation
-  // sweep, but a database of sparser views loses its tracks; docs/estimator.md).
+  // hand read end for end) is let go; the smoothing's filters go on from the old track.
+  // Only where a prior took part (not with PriorCombination::kNone). 0: never, the default:
+  // a small gain on the validation sweep, but real video lost more than it gained and a
+  // database of sparser views loses its tracks (docs/estimator.md).
   int prior_reset_frames = 0;
   double prior_reset_margin = 0.1;
   // The track's views: in a track, the entries seen from the `track_views` viewpoints
