@@ -1183,13 +1183,17 @@ TEST_F(EstimatorTest, TheTracksViewsJoinTheNeighboursInATrack) {
 // against the frames; with the reset, a few frames whose nearest view lies outside the
 // track's mode let the track go, and the new grasp is read.
 TEST_F(EstimatorTest, ATrackHeldAgainstTheFramesIsLetGo) {
+  // Two entries' joint angles apart (radians).
+  const auto from = [&](size_t e, size_t to) {
+    double squares = 0.0;
+    for (int j = 0; j < kNumDofs; ++j) squares += std::pow(db_->Angles(e)[j] - db_->Angles(to)[j], 2);
+    return std::sqrt(squares);
+  };
   const size_t a = EntryWithoutObject(*db_, 400);
   std::optional<size_t> other;
   for (size_t e = 0; e < db_->size() && !other.has_value(); ++e) {
     if (db_->Meta(e).with_object || !db_->Meta(e).has_hand || db_->Meta(e).viewpoint != db_->Meta(a).viewpoint) continue;
-    double squares = 0.0;
-    for (int j = 0; j < kNumDofs; ++j) squares += std::pow(db_->Angles(e)[j] - db_->Angles(a)[j], 2);
-    if (std::sqrt(squares) > 1.5) other = e;
+    if (from(e, a) > 1.5) other = e;
   }
   ASSERT_TRUE(other.has_value()) << "no other grasp from entry " << a << "'s view";
   const size_t b = *other;
@@ -1216,11 +1220,6 @@ TEST_F(EstimatorTest, ATrackHeldAgainstTheFramesIsLetGo) {
   EXPECT_EQ(let_go[8], b);
   // The new track then wanders within the new grasp's neighbourhood (the observation is
   // flat), never back to the old one.
-  const auto from = [&](uint32_t e, size_t to) {
-    double squares = 0.0;
-    for (int j = 0; j < kNumDofs; ++j) squares += std::pow(db_->Angles(e)[j] - db_->Angles(to)[j], 2);
-    return std::sqrt(squares);
-  };
   for (int frame = 9; frame < 15; ++frame) {
     EXPECT_LT(from(let_go[frame], b), from(let_go[frame], a)) << frame << ": entry " << let_go[frame];
     EXPECT_GT(from(let_go[frame], a), 1.0) << frame << ": entry " << let_go[frame];

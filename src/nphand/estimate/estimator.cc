@@ -920,18 +920,6 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     carried_sum += hyp[i].w;
   }
   for (WeightedPose& c : carried_) c.weight = carried_sum > 0.0 ? c.weight / carried_sum : 1.0 / carried_.size();
-  if (options_.prior_reset_frames > 0) {
-    double in_mode = std::numeric_limits<double>::infinity(), outside = in_mode;
-    for (const Candidate& h : hyp) {
-      double& nearest_of = (h.x - best.x).norm() <= 2.0 * options_.sigma_x ? in_mode : outside;
-      nearest_of = std::min(nearest_of, h.distance);
-    }
-    elsewhere_[side] = result->prior_used && in_mode - outside > options_.prior_reset_margin ? elsewhere_[side] + 1 : 0;
-    if (elsewhere_[side] >= options_.prior_reset_frames) {
-      carried_.clear();
-      elsewhere_[side] = 0;
-    }
-  }
 
   // Posteriors, confidence.
   // Summed by hand shape (grasp or gesture) and by object shape (the last slot: no object);
@@ -940,8 +928,10 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
   std::array<double, static_cast<int>(ObjectShape::kStick) + 2> object_mass{};
   constexpr size_t kNoObject = static_cast<int>(ObjectShape::kStick) + 1;
   // The mode's mean (mode_mean) sums the hypotheses of weight near the best, each by its
-  // weight, in the same pass: their distance from the best is the confidence's too.
+  // weight, in the same pass: their distance from the best is the confidence's too, and the
+  // prior's reset's (the nearest view within the track's mode and outside it).
   double squares = 0.0, mode = 0.0;
+  double in_mode = std::numeric_limits<double>::infinity(), outside = in_mode;
   Eigen::Matrix3d mean_rotation = Eigen::Matrix3d::Zero();
   JointAngles mean_angles{};
   double mean_weight = 0.0;
@@ -952,6 +942,8 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
     squares += h.w * h.w;
     const double from_best = (h.x - best.x).norm();
     if (from_best < options_.sigma_x) mode += h.w;
+    double& nearest_of = from_best <= 2.0 * options_.sigma_x ? in_mode : outside;
+    nearest_of = std::min(nearest_of, h.distance);
     if (h.w <= 0.0 || from_best >= options_.mode_mean) continue;
     for (int r = 0; r < 3; ++r) {
       for (int col = 0; col < 3; ++col) mean_rotation(r, col) += h.w * h.x[3 * r + col];
@@ -973,6 +965,13 @@ bool Estimator::Weigh(cv::Rect box, Lookup* lookup, FrameResult* result) {
   std::sort(result->objects.begin(), result->objects.end(), by_weight);
   result->effective_samples = squares > 0.0 ? 1.0 / squares : 0.0;
   result->confidence = std::min(1.0, mode);
+  if (options_.prior_reset_frames > 0) {
+    elsewhere_[side] = result->prior_used && in_mode - outside > options_.prior_reset_margin ? elsewhere_[side] + 1 : 0;
+    if (elsewhere_[side] >= options_.prior_reset_frames) {
+      carried_.clear();
+      elsewhere_[side] = 0;
+    }
+  }
 
   for (size_t r = 0; r < order.size() && static_cast<int>(r) < options_.top_n; ++r) {
     const Candidate& h = hyp[order[r]];
